@@ -1,0 +1,93 @@
+"""The lidar adapter: one batched cast for every robot at each scan instant.
+
+At ``lidar.rate_hz`` (SENSING stage) it casts all robots' beams against the static
+world and the other robots in one call, applies each robot's noise and dropout from
+the robot's own random stream, and publishes ``/<robot>/scan`` on the robot's host.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any, ClassVar
+
+import numpy as np
+
+from adapters.naming import topic
+from cosim.adapter import RunContext
+from cosim.hosts import HostId
+from cosim.kernel import Stage
+from cosim.messages import LaserScan
+from cosim.timebase import period_ns
+from models.kinematics import FleetState
+from models.lidar import ScanGeometry, apply_sensor_model, cast_reference
+from models.world import Warehouse
+
+
+class LidarAdapter:
+    """Planar lidar on every robot."""
+
+    name: ClassVar[str] = "lidar"
+    requires: ClassVar[tuple[str, ...]] = ("world", "fleet")
+
+    def __init__(self, run: RunContext) -> None:
+        cfg = run.scenario.lidar
+        self.geometry = ScanGeometry(
+            beams=cfg.beams,
+            fov_rad=math.radians(cfg.fov_deg),
+            range_min_m=cfg.range_min_m,
+            range_max_m=cfg.range_max_m,
+        )
+        self.noise_std_m = cfg.noise_std_m
+        self.dropout_prob = cfg.dropout_prob
+        self.period_ns = period_ns(cfg.rate_hz)
+        self.fleet = run.service(FleetState)
+        self.segments = run.service(Warehouse).segments()
+        self.rngs = [run.rng.stream(f"lidar/{name}") for name in self.fleet.names]
+        self.topics = [topic(name, "scan") for name in self.fleet.names]
+        self.scans = 0
+
+    def start(self, run: RunContext) -> None:
+        """Start the scan tick (disabled when ``lidar.beams`` is 0)."""
+        if self.geometry.beams > 0:
+            run.kernel.every(self.period_ns, lambda now: self._scan(run, now), stage=Stage.SENSING)
+
+    def _scan(self, run: RunContext, now_ns: int) -> None:
+        fleet = self.fleet
+        geometry = self.geometry
+        origins = fleet.positions
+        angles = fleet.yaw[:, None] + geometry.angles()[None, :]
+        circles = np.stack([fleet.x, fleet.y, fleet.radius_m], axis=1)
+        exact = cast_reference(
+            origins,
+            angles,
+            self.segments,
+            circles,
+            geometry.range_max_m,
+            exclude=np.arange(len(fleet)),
+        )
+        scan_time_s = self.period_ns / 1e9
+        for i, name in enumerate(fleet.names):
+            ranges = apply_sensor_model(
+                exact[i], geometry, self.noise_std_m, self.dropout_prob, self.rngs[i]
+            )
+            run.bus.publish(
+                self.topics[i],
+                LaserScan(
+                    now_ns,
+                    f"{name}/laser",
+                    geometry.angle_min_rad,
+                    geometry.angle_increment_rad,
+                    geometry.range_min_m,
+                    geometry.range_max_m,
+                    scan_time_s,
+                    ranges,
+                ),
+                HostId(name),
+            )
+        self.scans += 1
+
+    def finish(self, run: RunContext) -> Mapping[str, Any]:
+        """Scan instants and rays cast."""
+        rays = self.scans * len(self.fleet) * self.geometry.beams
+        return {"lidar_scans": self.scans, "lidar_rays": rays}

@@ -1,0 +1,141 @@
+"""Waypoint driving: every robot drives to random reachable points, one after another.
+
+The robot's software (on its own host) keeps the latest odometry, and at the control
+rate (CONTROL stage) a go-to-goal law computes every robot's command in one vectorized
+call; each command is published on ``/<robot>/cmd_vel``. A new waypoint is drawn from
+the robot's own random stream when the previous one is reached or after a timeout; it
+is a free point in straight-line sight of the robot, so that a controller that avoids
+nothing still does not drive into shelves.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any, ClassVar
+
+import numpy as np
+import shapely
+from shapely.geometry import LineString, box
+from shapely.prepared import prep
+
+from adapters.naming import topic
+from cosim.adapter import RunContext
+from cosim.bus import Envelope
+from cosim.hosts import HostId
+from cosim.kernel import Stage
+from cosim.messages import Goal, Message, Odometry, Twist
+from cosim.timebase import period_ns, s_to_ns
+from models.goto import GoToGains, go_to_goal
+from models.kinematics import FleetState
+from models.world import Warehouse
+
+SIGHT_MARGIN_M = 0.15
+"""Extra clearance around the straight path to a waypoint (m)."""
+GOAL_TIMEOUT_S = 60.0
+"""A waypoint not reached in this time is abandoned (s)."""
+
+
+class WaypointsAdapter:
+    """Random line-of-sight waypoints and a go-to-goal controller for every robot."""
+
+    name: ClassVar[str] = "waypoints"
+    requires: ClassVar[tuple[str, ...]] = ("world", "fleet")
+
+    def __init__(self, run: RunContext) -> None:
+        self.world = run.service(Warehouse)
+        fleet = run.service(FleetState)
+        self.names = list(fleet.names)
+        count = len(self.names)
+        self.radius_m = run.scenario.robots.radius_m
+        self.max_speed_mps = run.scenario.robots.max_speed_mps
+        self.gains = GoToGains()
+        self.period_ns = period_ns(run.scenario.robots.control_hz)
+        self.rngs = [run.rng.stream(f"waypoints/{name}") for name in self.names]
+        self.hosts = [HostId(name) for name in self.names]
+        self.pose = fleet.positions.copy()
+        self.yaw = fleet.yaw.copy()
+        self.goal = np.full((count, 2), np.nan)
+        self.goal_deadline_ns = np.zeros(count, dtype=np.int64)
+        obstacles = (
+            shapely.union_all([box(*b) for b in self.world.shelves])
+            if len(self.world.shelves)
+            else shapely.Point(-1e9, -1e9)
+        )
+        self._obstacles = prep(obstacles)
+        self.reached = 0
+        self.abandoned = 0
+
+    def start(self, run: RunContext) -> None:
+        """Subscribe to odometry, issue first waypoints, start the control tick."""
+        for index, (name, host) in enumerate(zip(self.names, self.hosts, strict=True)):
+            run.bus.subscribe(topic(name, "odom"), host, self._on_odom(index))
+        self._cmd_topics = [topic(name, "cmd_vel") for name in self.names]
+        self._goal_topics = [topic(name, "goal") for name in self.names]
+        for index in range(len(self.names)):
+            self._new_goal(run, index)
+        run.kernel.every(self.period_ns, lambda now: self._control(run, now), stage=Stage.CONTROL)
+
+    def _on_odom(self, index: int) -> Any:
+        def on_odom(message: Message, _envelope: Envelope) -> None:
+            assert isinstance(message, Odometry)
+            self.pose[index] = (message.x_m, message.y_m)
+            self.yaw[index] = message.yaw_rad
+
+        return on_odom
+
+    def _in_sight(self, start: np.ndarray, end: np.ndarray) -> bool:
+        path = LineString([tuple(start), tuple(end)]).buffer(self.radius_m + SIGHT_MARGIN_M)
+        return not self._obstacles.intersects(path)
+
+    def _new_goal(self, run: RunContext, index: int) -> None:
+        rng = self.rngs[index]
+        start = self.pose[index]
+        clearance = self.radius_m + SIGHT_MARGIN_M
+        for _ in range(200):
+            candidate = rng.uniform((0.0, 0.0), self.world.size_m)
+            if not self.world.is_free(candidate[None, :], clearance)[0]:
+                continue
+            if np.hypot(*(candidate - start)) < 1.0 or not self._in_sight(start, candidate):
+                continue
+            break
+        else:  # boxed in: stay put until the next attempt
+            candidate = start.copy()
+        self.goal[index] = candidate
+        now = run.kernel.now_ns
+        self.goal_deadline_ns[index] = now + s_to_ns(GOAL_TIMEOUT_S)
+        run.bus.publish(
+            self._goal_topics[index],
+            Goal(now, float(candidate[0]), float(candidate[1])),
+            self.hosts[index],
+        )
+        run.recorder.event(
+            now, self.names[index], "goal", f"x_m={candidate[0]:.3f} y_m={candidate[1]:.3f}"
+        )
+
+    def _control(self, run: RunContext, now_ns: int) -> None:
+        v, w, arrived = go_to_goal(
+            self.pose[:, 0],
+            self.pose[:, 1],
+            self.yaw,
+            self.goal[:, 0],
+            self.goal[:, 1],
+            self.max_speed_mps,
+            self.gains,
+        )
+        expired = now_ns >= self.goal_deadline_ns
+        for due in np.flatnonzero(arrived | expired):
+            index = int(due)
+            if arrived[index]:
+                self.reached += 1
+                run.recorder.event(now_ns, self.names[index], "arrived", "")
+            else:
+                self.abandoned += 1
+                run.recorder.event(now_ns, self.names[index], "abandoned", "goal timeout")
+            self._new_goal(run, index)
+        publish = run.bus.publish
+        for index, host in enumerate(self.hosts):
+            publish(self._cmd_topics[index], Twist(float(v[index]), float(w[index])), host)
+
+    def finish(self, run: RunContext) -> Mapping[str, Any]:
+        """Waypoints reached and abandoned."""
+        return {"waypoints_reached": self.reached, "waypoints_abandoned": self.abandoned}

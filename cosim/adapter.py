@@ -1,0 +1,107 @@
+"""The adapter contract and the context every adapter runs in.
+
+An adapter gives a model time, a rate and a place on the bus. It is a class registered
+under a name in the ``cosim.adapters`` entry-point group, constructed with the run's
+:class:`RunContext` (where it may offer services to later adapters), started once all
+adapters exist, and asked for its summary metrics at the end.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any, ClassVar, Protocol, TypeVar, runtime_checkable
+
+from cosim.bus import Bus
+from cosim.errors import RegistryError
+from cosim.hosts import Host, HostId, HostKind
+from cosim.kernel import Kernel
+from cosim.records import Recorder
+from cosim.rng import RngStreams
+from cosim.scenario.model import Scenario
+
+T = TypeVar("T")
+
+
+@dataclass
+class RunContext:
+    """Everything a run's adapters share.
+
+    Attributes:
+        scenario: the validated scenario.
+        kernel: the event kernel (integer ns).
+        bus: the topic bus.
+        rng: the run's named random streams.
+        recorder: the tables being recorded.
+        hosts: the hosts of the run, by id, in creation order.
+    """
+
+    scenario: Scenario
+    kernel: Kernel
+    bus: Bus
+    rng: RngStreams
+    recorder: Recorder
+    hosts: dict[HostId, Host] = field(default_factory=dict)
+    _services: dict[type[Any], Any] = field(default_factory=dict)
+
+    def add_host(self, host_id: str, kind: HostKind) -> HostId:
+        """Create a host; creating the same host twice with the same kind is allowed."""
+        hid = HostId(host_id)
+        existing = self.hosts.get(hid)
+        if existing is not None and existing.kind is not kind:
+            raise ValueError(f"host {host_id!r} exists already as a {existing.kind} host")
+        self.hosts[hid] = Host(hid, kind)
+        return hid
+
+    def provide(self, service: object) -> None:
+        """Offer ``service`` to later adapters, keyed by its type."""
+        kind = type(service)
+        if kind in self._services:
+            raise ValueError(f"a {kind.__name__} service is provided already")
+        self._services[kind] = service
+
+    def service(self, kind: type[T]) -> T:
+        """Return the service of type ``kind``.
+
+        Raises:
+            RegistryError: if no adapter provides it (an adapter forgot a requirement).
+        """
+        found = self._services.get(kind)
+        if found is None:
+            raise RegistryError(
+                f"no adapter provides a {kind.__name__}; add the adapter that does to `requires`"
+            )
+        return found  # type: ignore[no-any-return]
+
+    def has_service(self, kind: type[Any]) -> bool:
+        """Whether a service of type ``kind`` is provided."""
+        return kind in self._services
+
+
+@runtime_checkable
+class Adapter(Protocol):
+    """A running adapter."""
+
+    def start(self, run: RunContext) -> None:
+        """Start processes and subscriptions; called once, at time 0, in dependency order."""
+        ...
+
+    def finish(self, run: RunContext) -> Mapping[str, Any]:
+        """Return summary metrics (flat, JSON-serializable) at the end of the run."""
+        ...
+
+
+class AdapterType(Protocol):
+    """What the ``cosim.adapters`` entry points name: a class constructed with the run.
+
+    Attributes:
+        name: the registered name.
+        requires: names of adapters that must be constructed (and started) before.
+    """
+
+    name: ClassVar[str]
+    requires: ClassVar[tuple[str, ...]]
+
+    def __call__(self, run: RunContext) -> Adapter:
+        """Construct the adapter; may :meth:`RunContext.provide` services."""
+        ...

@@ -1,0 +1,60 @@
+"""Scenario assembly: which adapters a scenario needs, built in dependency order."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from cosim.adapter import Adapter, RunContext
+from cosim.bus import Bus
+from cosim.kernel import Kernel
+from cosim.records import Recorder
+from cosim.registry import AdapterRegistry
+from cosim.rng import RngStreams
+from cosim.scenario.model import Scenario
+
+
+def adapter_names(scenario: Scenario) -> list[str]:
+    """The adapters a scenario runs, before requirements are resolved."""
+    names = ["world", "fleet"]
+    if scenario.lidar.beams > 0:
+        names.append("lidar")
+    names += ["waypoints", "poses"]
+    names += [name for name in scenario.scenario.adapters if name not in names]
+    return names
+
+
+@dataclass
+class Assembly:
+    """A run ready to start: its context and its adapters in start order."""
+
+    run: RunContext
+    adapters: list[tuple[str, Adapter]]
+
+
+def assemble(
+    scenario: Scenario,
+    *,
+    names: list[str] | None = None,
+    registry: AdapterRegistry | None = None,
+    realtime: bool = False,
+) -> Assembly:
+    """Build the run context and construct the scenario's adapters.
+
+    Args:
+        scenario: the validated scenario.
+        names: adapters to run instead of :func:`adapter_names` (requirements are added).
+        registry: the adapter registry; defaults to the installed entry points.
+        realtime: pace the kernel against the wall clock.
+    """
+    registry = registry or AdapterRegistry.from_entry_points()
+    ordered = registry.resolve(names if names is not None else adapter_names(scenario))
+    kernel = Kernel(realtime=realtime)
+    recorder = Recorder(record_messages=scenario.record.messages)
+    bus = Bus(kernel, tap=recorder)
+    run = RunContext(
+        scenario=scenario, kernel=kernel, bus=bus, rng=RngStreams(scenario.seed), recorder=recorder
+    )
+    adapters: list[tuple[str, Adapter]] = []
+    for name in ordered:
+        adapters.append((name, registry.get(name)(run)))
+    return Assembly(run, adapters)

@@ -1,0 +1,201 @@
+"""The ``cosim`` command line.
+
+Exit status: 0 done; 2 invalid input (one line on stderr naming the file, the key, the
+value and what was expected); 1 internal failure (a bug: the traceback is printed).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import traceback
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any, NoReturn
+
+from cosim.errors import ConfigError, CosimError
+from cosim.progress import ProgressLine
+from cosim.scenario import (
+    Scenario,
+    load_scenario,
+    parse_override,
+    preset_names,
+    preset_summary,
+)
+
+EXIT_OK = 0
+EXIT_BUG = 1
+EXIT_INPUT = 2
+
+
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line and exit 2."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(EXIT_INPUT, f"{self.prog}: error: {message} (see `{self.prog} --help`)\n")
+
+
+def _non_negative_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"{value} is negative; expected an integer >= 0")
+    return value
+
+
+def _positive_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not value > 0 or value == float("inf"):
+        raise argparse.ArgumentTypeError(f"{text} is not a finite number > 0")
+    return value
+
+
+def _scenario_argument(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "scenario",
+        metavar="SCENARIO",
+        help="a scenario TOML file, or a preset name (list them with `cosim scenarios`)",
+    )
+    parser.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="SECTION.KEY=VALUE",
+        help="override one scenario key, e.g. --set lidar.rate_hz=20 (repeatable; values are TOML)",
+    )
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of every subcommand."""
+    parser = _Parser(
+        prog="cosim",
+        description=(
+            "Deterministic discrete-event co-simulation of autonomous mobile robot fleets: "
+            "kinematics, lidar and the network between robots, recorded as tables."
+        ),
+        epilog="Exit status: 0 done, 2 invalid input, 1 internal error.",
+    )
+    commands = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    commands.required = True
+
+    run = commands.add_parser(
+        "run",
+        help="run a scenario and write its results folder",
+        description=(
+            "Run a scenario to its duration and write summary.json, scenario.toml (the fully "
+            "resolved scenario) and tables/*.parquet into the output folder."
+        ),
+    )
+    _scenario_argument(run)
+    run.add_argument("--out", type=Path, help="results folder (default: runs/NAME-seedN)")
+    run.add_argument("--seed", type=_non_negative_int, help="override scenario.seed")
+    run.add_argument("--duration-s", type=_positive_float, help="override scenario.duration_s (s)")
+    run.add_argument("--force", action="store_true", help="replace results in a non-empty --out")
+    run.add_argument("--quiet", action="store_true", help="print nothing but errors")
+
+    check = commands.add_parser(
+        "check",
+        help="validate a scenario without running it",
+        description="Load and validate a scenario; print a one-line description of it.",
+    )
+    _scenario_argument(check)
+    check.add_argument("--print", action="store_true", help="print the fully resolved scenario")
+
+    commands.add_parser(
+        "scenarios",
+        help="list the presets, one line each",
+        description="List the scenario presets shipped with cosim.",
+    )
+    return parser
+
+
+def _load(args: argparse.Namespace) -> Scenario:
+    overrides: dict[str, Any] = {}
+    for text in args.overrides:
+        key, value = parse_override(text)
+        overrides[key] = value
+    return load_scenario(args.scenario, overrides)
+
+
+def _describe(scenario: Scenario) -> str:
+    world = scenario.world
+    return (
+        f"{scenario.name} ({scenario.source}): {scenario.robots.count} robots, "
+        f"{world.size_m[0]:g} m x {world.size_m[1]:g} m, layout {world.layout}, "
+        f"{scenario.scenario.duration_s:g} s, seed {scenario.seed}"
+    )
+
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    from cosim.runner import run
+
+    scenario = _load(args)
+    if args.seed is not None:
+        scenario = scenario.with_seed(args.seed)
+    out = args.out or Path("runs") / f"{scenario.name}-seed{scenario.seed}"
+    progress = None if args.quiet else ProgressLine(label=f"{scenario.name}: ")
+    try:
+        result = run(
+            scenario, duration_s=args.duration_s, out=out, force=args.force, progress=progress
+        )
+    finally:
+        if progress is not None:
+            progress.close()
+    if not args.quiet:
+        s = result.summary
+        print(
+            f"{s['scenario']} seed {s['seed']}: {s['sim_time_s']:g} s simulated in "
+            f"{s['wall_time_s']:.2f} s ({s['real_time_factor']:g}x real time), "
+            f"{s['robots']} robots, {s['events']} events, {s['messages_sent']} messages"
+        )
+        tables = ", ".join(sorted(result.tables))
+        print(f"results: {out}/  (summary.json, scenario.toml, tables/: {tables})")
+    return EXIT_OK
+
+
+def _cmd_check(args: argparse.Namespace) -> int:
+    from cosim.scenario import dump_scenario
+
+    scenario = _load(args)
+    print(f"ok: {_describe(scenario)}")
+    if args.print:
+        print(dump_scenario(scenario), end="")
+    return EXIT_OK
+
+
+def _cmd_scenarios(_args: argparse.Namespace) -> int:
+    names = preset_names()
+    width = max(len(n) for n in names)
+    for name in names:
+        print(f"{name:<{width}}  {preset_summary(name)}")
+    return EXIT_OK
+
+
+COMMANDS = {"run": _cmd_run, "check": _cmd_check, "scenarios": _cmd_scenarios}
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; return the exit status."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return COMMANDS[args.command](args)
+    except (CosimError, ConfigError) as error:
+        print(f"cosim: error: {error}", file=sys.stderr)
+        return EXIT_INPUT
+    except KeyboardInterrupt:
+        print("cosim: interrupted", file=sys.stderr)
+        return 130
+    except Exception:
+        traceback.print_exc()
+        print(
+            "cosim: internal error (a bug; please report it with the traceback above)",
+            file=sys.stderr,
+        )
+        return EXIT_BUG

@@ -1,0 +1,32 @@
+"""The error hierarchy of cosim.
+
+One root, :class:`CosimError`, and a few leaves. Every message names the offending
+file, key or value and says what was expected, so the command line can print it on
+one line and exit with status 2. Anything else escaping the run is a bug (status 1).
+"""
+
+from __future__ import annotations
+
+
+class CosimError(Exception):
+    """Root of every error that cosim raises on purpose."""
+
+
+class ConfigError(CosimError):
+    """A scenario or study file, or a ``--set`` override, is invalid."""
+
+
+class ScenarioError(CosimError):
+    """A scenario is well-formed but cannot be built (e.g. shelves that do not fit)."""
+
+
+class RegistryError(CosimError):
+    """An adapter name is unknown or an adapter plugin is broken."""
+
+
+class ExportError(CosimError):
+    """Results cannot be written (existing output folder, unwritable path, ...)."""
+
+
+class BridgeError(CosimError):
+    """An external system (DDS, SUMO, motion capture) cannot be reached or misbehaves."""

@@ -1,0 +1,1 @@
+"""Scenario presets shipped with cosim (one TOML file each)."""

@@ -1,0 +1,225 @@
+"""The recorder: taps the bus and collects tables, built as pandas DataFrames at the end.
+
+Rows are kept column-wise in compact buffers during the run (integers in ``array``,
+repeated strings interned as category codes) and turned into DataFrames once, so that
+recording stays cheap on the hot path. Times are recorded in integer nanoseconds and
+exported both as exact ``*_ns`` columns and as ``*_s`` seconds columns.
+"""
+
+from __future__ import annotations
+
+import math
+from array import array
+from collections.abc import Iterable, Mapping, Sequence
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+import pandas as pd
+
+from cosim.hosts import HostId
+from cosim.link import DeliveryStatus
+from cosim.timebase import NS_PER_S
+
+
+class _Interner:
+    """Maps repeated strings to small integer codes."""
+
+    def __init__(self) -> None:
+        self.codes: dict[str, int] = {}
+        self.values: list[str] = []
+
+    def code(self, value: str) -> int:
+        code = self.codes.get(value)
+        if code is None:
+            code = len(self.values)
+            self.codes[value] = code
+            self.values.append(value)
+        return code
+
+    def categorical(self, codes: array[int]) -> pd.Categorical[str]:
+        return pd.Categorical.from_codes(
+            np.frombuffer(codes, dtype=np.int32), categories=pd.Index(self.values)
+        )
+
+
+class Table:
+    """A table filled row by row or in column batches, rows kept in append order.
+
+    Args:
+        columns: column names in output order.
+        categorical: columns holding repeated strings (exported as ``category``).
+    """
+
+    def __init__(self, columns: Sequence[str], categorical: Iterable[str] = ()) -> None:
+        if not columns:
+            raise ValueError("a table needs at least one column")
+        self.columns = list(columns)
+        self._categorical = set(categorical)
+        self._rows: dict[str, list[Any]] = {name: [] for name in self.columns}
+        self._chunks: list[dict[str, npt.NDArray[Any]]] = []
+        self._length = 0
+
+    def append(self, **row: Any) -> None:
+        """Add one row; every column must be given."""
+        rows = self._rows
+        for name in self.columns:
+            rows[name].append(row[name])
+        self._length += 1
+
+    def extend(self, **columns: Any) -> None:
+        """Add rows from equal-length arrays; scalars are repeated to that length."""
+        self._flush_rows()
+        arrays = {name: np.asarray(columns[name]) for name in self.columns}
+        length = max((a.shape[0] for a in arrays.values() if a.ndim), default=1)
+        for name, values in arrays.items():
+            if values.ndim == 0:
+                arrays[name] = np.full(length, values.item())
+            elif values.shape[0] != length:
+                raise ValueError(f"column {name!r} has {values.shape[0]} rows, expected {length}")
+        self._chunks.append(arrays)
+        self._length += length
+
+    def _flush_rows(self) -> None:
+        if self._rows[self.columns[0]]:
+            self._chunks.append({name: np.asarray(v) for name, v in self._rows.items()})
+            self._rows = {name: [] for name in self.columns}
+
+    def __len__(self) -> int:
+        return self._length
+
+    def frame(self) -> pd.DataFrame:
+        """Return the rows as a DataFrame."""
+        self._flush_rows()
+        columns: dict[str, Any] = {}
+        for name in self.columns:
+            chunks = [chunk[name] for chunk in self._chunks]
+            values: Any = np.concatenate(chunks) if chunks else np.array([], dtype=float)
+            columns[name] = pd.Categorical(values) if name in self._categorical else values
+        return pd.DataFrame(columns, columns=self.columns)
+
+
+MESSAGE_COLUMNS = (
+    "t_sent_s",
+    "t_recv_s",
+    "src_host",
+    "dst_host",
+    "topic",
+    "bytes",
+    "status",
+    "t_sent_ns",
+    "t_recv_ns",
+)
+EVENT_COLUMNS = ("t_s", "source", "kind", "detail", "t_ns")
+
+
+class Recorder:
+    """Collects the run's tables: messages (from the bus tap), events, and adapter tables.
+
+    Args:
+        record_messages: keep a row per message and destination host.
+    """
+
+    def __init__(self, *, record_messages: bool = True) -> None:
+        self.record_messages = record_messages
+        self._hosts = _Interner()
+        self._topics = _Interner()
+        self._statuses = _Interner()
+        self._t_sent = array("q")
+        self._t_recv = array("q")
+        self._src = array("i")
+        self._dst = array("i")
+        self._topic = array("i")
+        self._bytes = array("q")
+        self._status = array("i")
+        self._events = Table(("t_ns", "source", "kind", "detail"))
+        self.tables: dict[str, Table] = {}
+        self.counts: dict[str, int] = {status.value: 0 for status in DeliveryStatus}
+
+    # -- the bus tap ---------------------------------------------------------------
+    def on_transfer(
+        self,
+        t_sent_ns: int,
+        t_recv_ns: int | None,
+        src: HostId,
+        dst: HostId,
+        topic: str,
+        nbytes: int,
+        status: DeliveryStatus,
+    ) -> None:
+        """Record one message towards one destination host (see :class:`cosim.bus.BusTap`)."""
+        self.counts[status.value] += 1
+        if not self.record_messages:
+            return
+        self._t_sent.append(t_sent_ns)
+        self._t_recv.append(-1 if t_recv_ns is None else t_recv_ns)
+        self._src.append(self._hosts.code(src))
+        self._dst.append(self._hosts.code(dst))
+        self._topic.append(self._topics.code(topic))
+        self._bytes.append(nbytes)
+        self._status.append(self._statuses.code(status.value))
+
+    # -- events and adapter tables ---------------------------------------------------
+    def event(self, t_ns: int, source: str, kind: str, detail: str = "") -> None:
+        """Record a discrete event (``source`` is the component, ``kind`` a short verb)."""
+        self._events.append(t_ns=t_ns, source=source, kind=kind, detail=detail)
+
+    def table(self, name: str, columns: Sequence[str], categorical: Iterable[str] = ()) -> Table:
+        """Create (once) and return the table ``name``; it is exported as ``tables/NAME``."""
+        if name in self.tables or name in ("messages", "events"):
+            raise ValueError(f"table {name!r} exists already")
+        table = Table(columns, categorical)
+        self.tables[name] = table
+        return table
+
+    # -- export ----------------------------------------------------------------------
+    def messages_frame(self) -> pd.DataFrame:
+        """The messages table: one row per message and destination host."""
+        t_sent = np.frombuffer(self._t_sent, dtype=np.int64)
+        t_recv = np.frombuffer(self._t_recv, dtype=np.int64)
+        received = t_recv >= 0
+        t_recv_s = np.where(received, t_recv / NS_PER_S, math.nan)
+        return pd.DataFrame(
+            {
+                "t_sent_s": t_sent / NS_PER_S,
+                "t_recv_s": t_recv_s,
+                "src_host": self._hosts.categorical(self._src),
+                "dst_host": self._hosts.categorical(self._dst),
+                "topic": self._topics.categorical(self._topic),
+                "bytes": np.frombuffer(self._bytes, dtype=np.int64),
+                "status": self._statuses.categorical(self._status),
+                "t_sent_ns": t_sent,
+                "t_recv_ns": pd.arrays.IntegerArray(np.where(received, t_recv, 0), ~received),
+            },
+            columns=list(MESSAGE_COLUMNS),
+        )
+
+    def events_frame(self) -> pd.DataFrame:
+        """The events table (t_s, source, kind, detail, t_ns)."""
+        frame = self._events.frame()
+        t_ns = frame["t_ns"].to_numpy(dtype=np.int64)
+        frame = frame.assign(t_s=t_ns / NS_PER_S, t_ns=t_ns)
+        for column in ("source", "kind"):
+            frame[column] = frame[column].astype("category")
+        frame["detail"] = frame["detail"].astype(str)
+        return frame[list(EVENT_COLUMNS)]
+
+    def frames(self) -> dict[str, pd.DataFrame]:
+        """Every table as a DataFrame, keyed by table name."""
+        frames = {"messages": self.messages_frame(), "events": self.events_frame()}
+        for name, table in self.tables.items():
+            frames[name] = table.frame()
+        return frames
+
+
+def ns_column(values: npt.ArrayLike) -> npt.NDArray[np.float64]:
+    """Convert an array of integer nanoseconds to float seconds."""
+    return np.asarray(values, dtype=np.int64) / NS_PER_S
+
+
+def merge_counts(into: dict[str, Any], extra: Mapping[str, Any]) -> None:
+    """Merge summary entries, refusing to overwrite an existing key."""
+    for key, value in extra.items():
+        if key in into:
+            raise ValueError(f"summary key {key!r} reported twice")
+        into[key] = value

@@ -1,0 +1,182 @@
+"""Running a scenario: assemble, start, run the kernel, collect the summary and tables."""
+
+from __future__ import annotations
+
+import json
+import platform
+import shutil
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from importlib.metadata import version
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from cosim.assembly import assemble
+from cosim.errors import ExportError
+from cosim.records import merge_counts
+from cosim.registry import AdapterRegistry
+from cosim.scenario.loader import dump_scenario
+from cosim.scenario.model import Scenario
+from cosim.timebase import NS_PER_S, s_to_ns
+
+ProgressFn = Callable[[float, float, float], None]
+"""Progress callback: (sim time s, duration s, wall time s)."""
+
+OUTPUTS = ("summary.json", "scenario.toml", "tables", "figures", "bag")
+"""What a run writes into its folder (``--force`` removes exactly these)."""
+
+
+@dataclass
+class RunResult:
+    """The outcome of a run.
+
+    Attributes:
+        scenario: the scenario that ran (with its seed and duration).
+        summary: flat metrics and provenance.
+        tables: DataFrames by table name (``poses``, ``messages``, ``events``, ...).
+        out: the run folder, when written.
+    """
+
+    scenario: Scenario
+    summary: dict[str, Any]
+    tables: dict[str, pd.DataFrame] = field(repr=False)
+    out: Path | None = None
+
+
+def cosim_version() -> str:
+    """The installed cosim version."""
+    return version("cosim")
+
+
+def execute(
+    scenario: Scenario,
+    *,
+    progress: ProgressFn | None = None,
+    names: list[str] | None = None,
+    registry: AdapterRegistry | None = None,
+) -> RunResult:
+    """Run a scenario to its duration in memory and return its result.
+
+    Args:
+        scenario: the scenario.
+        progress: called with (sim s, duration s, wall s) during the run.
+        names: adapters to run instead of the scenario's (see :func:`cosim.assembly.assemble`).
+        registry: adapter registry; defaults to the installed entry points.
+    """
+    assembly = assemble(scenario, names=names, registry=registry)
+    run = assembly.run
+    duration_s = scenario.scenario.duration_s
+    until_ns = s_to_ns(duration_s)
+    wall_start = time.perf_counter()
+    for _name, adapter in assembly.adapters:
+        adapter.start(run)
+
+    def report(now_ns: int, _events: int) -> None:
+        if progress is not None:
+            progress(now_ns / NS_PER_S, duration_s, time.perf_counter() - wall_start)
+
+    events = run.kernel.run(until_ns, progress=report if progress else None)
+    wall_s = time.perf_counter() - wall_start
+    counts = run.recorder.counts
+    sent = sum(counts.values())
+    summary: dict[str, Any] = {
+        "scenario": scenario.name,
+        "source": scenario.source,
+        "seed": scenario.seed,
+        "version": cosim_version(),
+        "python": platform.python_version(),
+        "sim_time_s": duration_s,
+        "wall_time_s": round(wall_s, 4),
+        "real_time_factor": round(duration_s / wall_s, 2) if wall_s > 0 else float("inf"),
+        "events": events,
+        "messages_sent": sent,
+        "messages_delivered": counts["delivered"],
+        "messages_dropped": sent - counts["delivered"],
+    }
+    for name, adapter in assembly.adapters:
+        try:
+            merge_counts(summary, adapter.finish(run))
+        except ValueError as error:
+            raise RuntimeError(f"adapter {name!r}: {error}") from error
+    return RunResult(scenario, summary, run.recorder.frames())
+
+
+def prepare_out(out: Path, *, force: bool) -> None:
+    """Make sure ``out`` can take a run's results.
+
+    Raises:
+        ExportError: if ``out`` is a file, or a non-empty folder and ``force`` is false.
+    """
+    if out.exists() and not out.is_dir():
+        raise ExportError(f"{out}: exists and is not a folder")
+    if out.is_dir() and any(out.iterdir()):
+        if not force:
+            raise ExportError(f"{out}: folder is not empty; not overwriting (use --force)")
+        for name in OUTPUTS:
+            target = out / name
+            if target.is_dir():
+                shutil.rmtree(target)
+            elif target.exists():
+                target.unlink()
+
+
+def write_run(result: RunResult, out: Path, *, tables: bool = True) -> None:
+    """Write a run's folder atomically: into ``out.partial`` first, then renamed in place."""
+    out = Path(out)
+    partial = out.with_name(out.name + ".partial")
+    if partial.exists():
+        shutil.rmtree(partial)
+    try:
+        partial.mkdir(parents=True)
+        (partial / "scenario.toml").write_text(dump_scenario(result.scenario), encoding="utf-8")
+        if tables:
+            (partial / "tables").mkdir()
+            for name, frame in result.tables.items():
+                frame.to_parquet(partial / "tables" / f"{name}.parquet", index=False)
+        (partial / "summary.json").write_text(
+            json.dumps(result.summary, indent=2) + "\n", encoding="utf-8"
+        )
+        out.mkdir(parents=True, exist_ok=True)
+        for entry in sorted(partial.iterdir()):
+            entry.rename(out / entry.name)
+        partial.rmdir()
+    except OSError as error:
+        raise ExportError(f"{out}: cannot write results ({error})") from error
+    result.out = out
+
+
+def run(
+    scenario: Scenario,
+    *,
+    seed: int | None = None,
+    duration_s: float | None = None,
+    out: str | Path | None = None,
+    force: bool = False,
+    progress: ProgressFn | None = None,
+) -> RunResult:
+    """Run a scenario; optionally write its folder.
+
+    Args:
+        scenario: from :func:`cosim.load_scenario`.
+        seed: overrides ``scenario.seed``.
+        duration_s: overrides ``scenario.duration_s`` (s).
+        out: folder to write (``summary.json``, ``scenario.toml``, ``tables/``).
+        force: replace the results in a non-empty ``out``.
+        progress: called with (sim s, duration s, wall s) during the run.
+
+    Returns:
+        The run's summary and tables.
+    """
+    if seed is not None:
+        scenario = scenario.with_seed(seed)
+    if duration_s is not None:
+        scenario = scenario.with_duration(duration_s)
+    if out is not None:
+        prepare_out(Path(out), force=force)
+    result = execute(scenario, progress=progress)
+    if out is not None:
+        write_run(result, Path(out), tables=scenario.record.tables)
+    return result

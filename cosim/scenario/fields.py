@@ -1,0 +1,273 @@
+"""Typed configuration fields: declaration (:func:`param`) and validation (:func:`build`).
+
+Sections of a scenario are frozen dataclasses whose fields are declared with
+:func:`param`. :func:`build` turns a TOML table into such a dataclass, checking every
+key against the annotations and the declared bounds; a problem becomes a
+:class:`~cosim.errors.ConfigError` naming the file, the section, the key, the value and
+what was expected. Unknown keys get a "did you mean" suggestion.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import math
+import types
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, field
+from typing import Any, Literal, TypeVar, Union, get_args, get_origin, get_type_hints
+
+from cosim.errors import ConfigError
+
+
+@dataclass(frozen=True, slots=True)
+class Bounds:
+    """Numeric bounds of a field (applied to every element of a list)."""
+
+    ge: float | None = None
+    gt: float | None = None
+    le: float | None = None
+    lt: float | None = None
+
+    def violation(self, value: float) -> str | None:
+        """Return a description of the violated bound, or ``None``."""
+        if self.gt is not None and not value > self.gt:
+            return f"> {self.gt:g}"
+        if self.ge is not None and not value >= self.ge:
+            return f">= {self.ge:g}"
+        if self.lt is not None and not value < self.lt:
+            return f"< {self.lt:g}"
+        if self.le is not None and not value <= self.le:
+            return f"<= {self.le:g}"
+        return None
+
+    def describe(self) -> str:
+        """Describe all bounds, e.g. ``>= 0 and <= 1``."""
+        parts = []
+        if self.gt is not None:
+            parts.append(f"> {self.gt:g}")
+        if self.ge is not None:
+            parts.append(f">= {self.ge:g}")
+        if self.lt is not None:
+            parts.append(f"< {self.lt:g}")
+        if self.le is not None:
+            parts.append(f"<= {self.le:g}")
+        return " and ".join(parts)
+
+
+def param(
+    default: Any,
+    doc: str,
+    *,
+    ge: float | None = None,
+    gt: float | None = None,
+    le: float | None = None,
+    lt: float | None = None,
+) -> Any:
+    """Declare a configuration field with a default, a one-line doc and numeric bounds."""
+    return field(default=default, metadata={"doc": doc, "bounds": Bounds(ge, gt, le, lt)})
+
+
+@dataclass(frozen=True, slots=True)
+class Problem:
+    """A cross-field problem found by a section's ``problems()`` method."""
+
+    key: str
+    value: Any
+    expected: str
+
+
+class _MismatchError(Exception):
+    def __init__(self, expected: str) -> None:
+        super().__init__(expected)
+        self.expected = expected
+
+
+def describe(hint: Any) -> str:
+    """Say in words what a type annotation accepts."""
+    origin = get_origin(hint)
+    if hint is bool:
+        return "true or false"
+    if hint is int:
+        return "an integer"
+    if hint is float:
+        return "a number"
+    if hint is str:
+        return "a string"
+    if origin is Literal:
+        return "one of " + ", ".join(repr(a) for a in get_args(hint))
+    if origin is tuple:
+        args = get_args(hint)
+        if len(args) == 2 and args[1] is Ellipsis:
+            inner = describe(args[0])
+            return f"a list of {_plural(inner)}"
+        return f"a list of {len(args)} {_plural(describe(args[0]))}"
+    if origin in (Union, types.UnionType):
+        return " or ".join(describe(a) for a in get_args(hint))
+    return str(hint)
+
+
+def _plural(phrase: str) -> str:
+    for article in ("an ", "a "):
+        if phrase.startswith(article):
+            phrase = phrase[len(article) :]
+            break
+    if phrase == "true or false":
+        return "booleans"
+    if phrase.startswith("one of "):
+        return "values " + phrase
+    if phrase.startswith("list of "):
+        return "lists of " + phrase[len("list of ") :]
+    return phrase + "s"
+
+
+def coerce(value: Any, hint: Any) -> Any:
+    """Convert a TOML value to the annotated type, or raise ``_MismatchError``."""
+    origin = get_origin(hint)
+    if hint is bool:
+        if isinstance(value, bool):
+            return value
+    elif hint is int:
+        if isinstance(value, int) and not isinstance(value, bool):
+            return value
+        if isinstance(value, float) and value.is_integer():
+            return int(value)
+    elif hint is float:
+        if isinstance(value, int | float) and not isinstance(value, bool):
+            if math.isfinite(value):
+                return float(value)
+            raise _MismatchError("a finite number")
+    elif hint is str:
+        if isinstance(value, str):
+            return value
+    elif origin is Literal:
+        if value in get_args(hint) and type(value) in {type(a) for a in get_args(hint)}:
+            return value
+    elif origin is tuple:
+        if isinstance(value, list | tuple):
+            args = get_args(hint)
+            if len(args) == 2 and args[1] is Ellipsis:
+                return tuple(coerce(item, args[0]) for item in value)
+            if len(value) == len(args):
+                return tuple(coerce(item, arg) for item, arg in zip(value, args, strict=True))
+    elif origin in (Union, types.UnionType):
+        for arg in get_args(hint):
+            try:
+                return coerce(value, arg)
+            except _MismatchError:
+                continue
+    raise _MismatchError(describe(hint))
+
+
+def _numbers(value: Any) -> Iterator[float]:
+    if isinstance(value, bool):
+        return
+    if isinstance(value, int | float):
+        yield value
+    elif isinstance(value, tuple):
+        for item in value:
+            yield from _numbers(item)
+
+
+def format_problem(origin: str, section: str, key: str, value: Any, expected: str) -> str:
+    """Format the one-line message used for every configuration error."""
+    return f"{origin}: [{section}] {key} = {_show(value)}: expected {expected}"
+
+
+def _show(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, list | tuple):
+        return "[" + ", ".join(_show(v) for v in value) + "]"
+    return repr(value)
+
+
+def suggest(name: str, options: list[str]) -> str:
+    """Return "; did you mean 'x'?" for the closest option, or a list of the valid ones."""
+    close = difflib.get_close_matches(name, options, n=1, cutoff=0.6)
+    if close:
+        return f"; did you mean {close[0]!r}?"
+    return "; valid: " + ", ".join(options)
+
+
+T = TypeVar("T")
+
+
+def field_names(cls: type[Any]) -> list[str]:
+    """Names of a section's fields in declaration order."""
+    return [f.name for f in dataclasses.fields(cls)]
+
+
+def build(
+    cls: type[T],
+    table: Mapping[str, Any],
+    *,
+    section: str,
+    origins: Mapping[str, str],
+    default_origin: str,
+) -> T:
+    """Validate a TOML table and build the section dataclass ``cls`` from it.
+
+    Args:
+        cls: the section dataclass.
+        table: the TOML table (key -> value).
+        section: the section's name, for messages.
+        origins: where each key came from (a file, or ``--set``), for messages.
+        default_origin: the origin reported for cross-field problems of defaults.
+
+    Raises:
+        ConfigError: naming the origin, the section, the key, the value and what was
+            expected, for an unknown key, a wrong type or a value out of bounds.
+    """
+    hints = get_type_hints(cls)
+    fields = {f.name: f for f in dataclasses.fields(cls)}  # type: ignore[arg-type]
+    values: dict[str, Any] = {}
+    for key, raw in table.items():
+        origin = origins.get(key, default_origin)
+        if key not in fields:
+            raise ConfigError(
+                f"{origin}: [{section}] unknown key {key!r}" + suggest(key, list(fields))
+            )
+        hint = hints[key]
+        bounds: Bounds = fields[key].metadata.get("bounds", Bounds())
+        bound_text = bounds.describe()
+        try:
+            value = coerce(raw, hint)
+        except _MismatchError as mismatch:
+            expected = mismatch.expected + (f" {bound_text}" if bound_text else "")
+            raise ConfigError(format_problem(origin, section, key, raw, expected)) from None
+        for number in _numbers(value):
+            if bounds.violation(number) is not None:
+                expected = describe(hint) + f" {bound_text}"
+                if isinstance(value, tuple):
+                    expected += " (every element)"
+                raise ConfigError(format_problem(origin, section, key, raw, expected))
+        values[key] = value
+    instance = cls(**values)
+    problems = getattr(instance, "problems", None)
+    if problems is not None:
+        for problem in problems():
+            origin = origins.get(problem.key, default_origin)
+            raise ConfigError(
+                format_problem(origin, section, problem.key, problem.value, problem.expected)
+            )
+    return instance
+
+
+def docs(cls: type[Any]) -> dict[str, str]:
+    """The one-line doc of every field of a section."""
+    return {f.name: f.metadata.get("doc", "") for f in dataclasses.fields(cls)}
+
+
+__all__ = [
+    "Bounds",
+    "Problem",
+    "build",
+    "coerce",
+    "describe",
+    "docs",
+    "field_names",
+    "format_problem",
+    "param",
+    "suggest",
+]

@@ -1,0 +1,179 @@
+"""Loading scenarios: TOML files or presets, ``--set`` overrides, and the resolved dump."""
+
+from __future__ import annotations
+
+import copy
+import math
+import tomllib
+from collections.abc import Mapping
+from dataclasses import fields
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from cosim.errors import ConfigError
+from cosim.scenario.fields import build, suggest
+from cosim.scenario.model import Scenario, section_types
+
+PRESET_PACKAGE = "cosim.presets"
+
+
+def preset_names() -> list[str]:
+    """Names of the presets shipped with cosim, sorted."""
+    folder = resources.files(PRESET_PACKAGE)
+    return sorted(p.name[: -len(".toml")] for p in folder.iterdir() if p.name.endswith(".toml"))
+
+
+def preset_text(name: str) -> str:
+    """The TOML text of preset ``name``."""
+    return (resources.files(PRESET_PACKAGE) / f"{name}.toml").read_text(encoding="utf-8")
+
+
+def preset_summary(name: str) -> str:
+    """The first comment line of a preset (its one-line description)."""
+    for line in preset_text(name).splitlines():
+        if line.startswith("#"):
+            return line.lstrip("# ").strip()
+    return ""
+
+
+def _read_source(spec: str | Path) -> tuple[str, dict[str, Any]]:
+    """Return (origin, raw TOML dict) for a path or a preset name."""
+    text_spec = str(spec)
+    path = Path(spec)
+    looks_like_file = isinstance(spec, Path) or text_spec.endswith(".toml") or "/" in text_spec
+    if not looks_like_file:
+        names = preset_names()
+        if text_spec not in names:
+            raise ConfigError(
+                f"{text_spec}: not a scenario file nor a preset"
+                + suggest(text_spec, names)
+                + " (list them with `cosim scenarios`)"
+            )
+        origin = f"preset {text_spec}"
+        text = preset_text(text_spec)
+    else:
+        origin = str(path)
+        if not path.is_file():
+            raise ConfigError(f"{path}: scenario file not found")
+        try:
+            text = path.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as error:
+            raise ConfigError(f"{path}: cannot read scenario file ({error})") from None
+    try:
+        return origin, tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        raise ConfigError(f"{origin}: malformed TOML: {error}") from None
+
+
+def parse_override(text: str) -> tuple[str, Any]:
+    """Parse ``section.key=value`` from the command line; the value is read as TOML.
+
+    A value that is not valid TOML (``all_rows``) is taken as a plain string; the
+    schema then checks its type like any other value.
+
+    Raises:
+        ConfigError: if ``text`` has no ``=`` or no ``section.key`` before it.
+    """
+    key, sep, raw = text.partition("=")
+    key = key.strip()
+    if not sep or key.count(".") != 1 or not all(key.split(".")):
+        raise ConfigError(f"--set {text}: expected section.key=value, e.g. lidar.rate_hz=20")
+    raw = raw.strip()
+    try:
+        value = tomllib.loads(f"v = {raw}")["v"]
+    except tomllib.TOMLDecodeError:
+        value = raw
+    return key, value
+
+
+def load_scenario(
+    spec: str | Path,
+    overrides: Mapping[str, Any] | None = None,
+    *,
+    override_origin: str = "--set",
+) -> Scenario:
+    """Load and validate a scenario from a TOML file or a preset name.
+
+    Args:
+        spec: a path to a TOML file, or the name of a preset (``cosim scenarios``).
+        overrides: ``{"section.key": value}`` applied on top of the file.
+        override_origin: how messages name the origin of overrides.
+
+    Raises:
+        ConfigError: for a missing file, malformed TOML, an unknown section or key, or a
+            value of the wrong type or out of bounds; the message names all of them.
+    """
+    origin, raw = _read_source(spec)
+    raw = copy.deepcopy(raw)
+    origins: dict[tuple[str, str], str] = {}
+    for dotted, value in (overrides or {}).items():
+        section, _, key = dotted.partition(".")
+        if not key or "." in key:
+            raise ConfigError(f"{override_origin} {dotted}: expected section.key")
+        table = raw.setdefault(section, {})
+        if not isinstance(table, dict):
+            raise ConfigError(f"{origin}: {section} must be a [section] table")
+        table[key] = value
+        origins[(section, key)] = f"{override_origin} {dotted}"
+    return _build(raw, origin, origins)
+
+
+def _build(raw: dict[str, Any], origin: str, origins: dict[tuple[str, str], str]) -> Scenario:
+    types = section_types()
+    built: dict[str, Any] = {}
+    for section, table in raw.items():
+        if section not in types:
+            where = next((o for (s, _), o in origins.items() if s == section), origin)
+            raise ConfigError(
+                f"{where}: unknown section [{section}]" + suggest(section, list(types))
+            )
+        if not isinstance(table, dict):
+            raise ConfigError(
+                f"{origin}: {section} = {table!r}: expected a [{section}] table of keys"
+            )
+        key_origins = {key: origins.get((section, key), origin) for key in table}
+        built[section] = build(
+            types[section], table, section=section, origins=key_origins, default_origin=origin
+        )
+    return Scenario(**built, source=origin)
+
+
+def _toml_value(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if not math.isfinite(value):
+            raise ValueError(f"cannot write non-finite {value} to TOML")
+        return repr(value)
+    if isinstance(value, str):
+        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(value, list | tuple):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    raise TypeError(f"cannot write {type(value).__name__} to TOML")
+
+
+def dump_scenario(scenario: Scenario) -> str:
+    """The fully resolved scenario as TOML: every section, every key.
+
+    Loading the text back gives an equal :class:`Scenario`.
+    """
+    lines = [f"# resolved from {scenario.source}"]
+    for name in section_types():
+        section = getattr(scenario, name)
+        lines.append("")
+        lines.append(f"[{name}]")
+        for f in fields(section):
+            lines.append(f"{f.name} = {_toml_value(getattr(section, f.name))}")
+    return "\n".join(lines) + "\n"
+
+
+def scenario_from_text(text: str, origin: str) -> Scenario:
+    """Load a scenario from TOML text (used for round trips and tests)."""
+    try:
+        raw = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        raise ConfigError(f"{origin}: malformed TOML: {error}") from None
+    return _build(raw, origin, {})

@@ -1,0 +1,54 @@
+"""The resolved scenario: one frozen dataclass per section."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, fields, replace
+from typing import Any, get_type_hints
+
+from cosim.scenario.sections import (
+    LidarConfig,
+    RecordConfig,
+    RobotsConfig,
+    ScenarioSection,
+    WorldConfig,
+)
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A validated scenario. Build it with :func:`cosim.load_scenario`.
+
+    Attributes:
+        source: the file or preset it was loaded from (for messages and provenance).
+    """
+
+    scenario: ScenarioSection = field(default_factory=ScenarioSection)
+    world: WorldConfig = field(default_factory=WorldConfig)
+    robots: RobotsConfig = field(default_factory=RobotsConfig)
+    lidar: LidarConfig = field(default_factory=LidarConfig)
+    record: RecordConfig = field(default_factory=RecordConfig)
+    source: str = field(default="<defaults>", compare=False)
+
+    @property
+    def seed(self) -> int:
+        """The scenario seed."""
+        return self.scenario.seed
+
+    @property
+    def name(self) -> str:
+        """The scenario name."""
+        return self.scenario.name
+
+    def with_seed(self, seed: int) -> Scenario:
+        """Return a copy with another seed."""
+        return replace(self, scenario=replace(self.scenario, seed=seed))
+
+    def with_duration(self, duration_s: float) -> Scenario:
+        """Return a copy with another duration (s)."""
+        return replace(self, scenario=replace(self.scenario, duration_s=duration_s))
+
+
+def section_types() -> dict[str, type[Any]]:
+    """Section name -> section dataclass, in file order."""
+    hints = get_type_hints(Scenario)
+    return {f.name: hints[f.name] for f in fields(Scenario) if f.name != "source"}

@@ -1,0 +1,123 @@
+"""The sections of a scenario file and their keys (the contract in DESIGN.md).
+
+Each section is a frozen dataclass; every field has a default, a one-line doc, and its
+unit in its name. Cross-field rules live in each section's ``problems()``.
+
+Robot defaults are those of a Clearpath Jackal: 508 mm x 430 mm footprint (circumscribed
+radius 0.33 m) and 2.0 m/s top speed from Clearpath's Jackal datasheet; acceleration
+(2.0 m/s^2, 3.0 rad/s^2) and yaw-rate (2.0 rad/s) limits from the planner parameters in
+Clearpath's ``jackal_navigation`` package. The default cruise speed is 1.0 m/s, a
+typical indoor setting, below the hardware's 2.0 m/s.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import Literal
+
+from cosim.scenario.fields import Problem, param
+
+Layout = Literal["random", "all_rows", "two_corridors"]
+Placement = Literal["dock", "random", "explicit"]
+
+
+@dataclass(frozen=True)
+class ScenarioSection:
+    """``[scenario]``: identity, length and seed of a run."""
+
+    name: str = param("unnamed", "name shown in summaries and folder names")
+    duration_s: float = param(60.0, "simulated time to run (s)", gt=0)
+    seed: int = param(1, "scenario seed; every random stream derives from it", ge=0)
+    adapters: tuple[str, ...] = param((), "extra adapters to start, by registered name")
+
+
+@dataclass(frozen=True)
+class WorldConfig:
+    """``[world]``: the warehouse hall (frame ``map``, origin at the south-west inner corner)."""
+
+    size_m: tuple[float, float] = param((30.0, 30.0), "inner room size [x, y] (m)", gt=0)
+    layout: Layout = param("random", "shelf layout")
+    shelf_size_m: tuple[float, float] = param(
+        (2.0, 0.8), "shelf footprint [length, depth] (m)", gt=0
+    )
+    shelf_count: int = param(24, "number of shelves (rows layouts: at most what fits)", ge=0)
+    shelves_per_rack: int = param(3, "rows layouts: shelves end to end in one rack", ge=1)
+    aisle_width_m: float = param(1.6, "minimum free gap between shelves and walls (m)", gt=0)
+    wall_thickness_m: float = param(0.2, "thickness of the outer walls (m)", gt=0)
+
+    def problems(self) -> Iterator[Problem]:
+        """Shelves must be smaller than the room."""
+        length, depth = self.shelf_size_m
+        if min(length, depth) + 2 * self.aisle_width_m > min(self.size_m):
+            yield Problem(
+                "shelf_size_m",
+                list(self.shelf_size_m),
+                f"shelves plus two aisles ({self.aisle_width_m:g} m) to fit in the room "
+                f"{list(self.size_m)}",
+            )
+
+
+@dataclass(frozen=True)
+class RobotsConfig:
+    """``[robots]``: the fleet (differential drive, Jackal defaults)."""
+
+    count: int = param(4, "number of robots", gt=0)
+    model: Literal["jackal"] = param("jackal", "robot model")
+    placement: Placement = param("dock", "start placement")
+    positions: tuple[tuple[float, float, float], ...] = param(
+        (), "explicit placement: [[x_m, y_m, yaw_rad], ...] in map"
+    )
+    max_speed_mps: float = param(1.0, "forward speed limit (m/s)", gt=0, le=2.0)
+    max_reverse_mps: float = param(0.3, "backward speed limit (m/s)", ge=0)
+    max_yaw_rate_radps: float = param(2.0, "yaw-rate limit (rad/s)", gt=0)
+    max_accel_mps2: float = param(2.0, "linear acceleration limit (m/s^2)", gt=0)
+    max_yaw_accel_radps2: float = param(3.0, "yaw acceleration limit (rad/s^2)", gt=0)
+    radius_m: float = param(0.33, "footprint radius (m)", gt=0)
+    control_hz: float = param(20.0, "kinematics and odometry rate (Hz)", gt=0, le=1000)
+
+    def problems(self) -> Iterator[Problem]:
+        """Explicit placement needs one pose per robot."""
+        if self.placement == "explicit" and len(self.positions) != self.count:
+            yield Problem(
+                "positions",
+                [list(p) for p in self.positions],
+                f"{self.count} poses [x_m, y_m, yaw_rad] (one per robot) for placement 'explicit'",
+            )
+        if self.placement != "explicit" and self.positions:
+            yield Problem(
+                "positions",
+                [list(p) for p in self.positions],
+                "no positions unless placement = 'explicit'",
+            )
+
+
+@dataclass(frozen=True)
+class LidarConfig:
+    """``[lidar]``: a planar lidar on every robot (REP 117 ranges)."""
+
+    beams: int = param(360, "beams per scan (0 disables the lidar)", ge=0)
+    fov_deg: float = param(
+        360.0, "field of view (deg), centred on the robot's heading", gt=0, le=360
+    )
+    range_min_m: float = param(0.1, "minimum valid range (m)", ge=0)
+    range_max_m: float = param(10.0, "maximum range (m)", gt=0)
+    rate_hz: float = param(10.0, "scan rate (Hz)", gt=0, le=1000)
+    noise_std_m: float = param(0.01, "Gaussian range noise (m)", ge=0)
+    dropout_prob: float = param(0.0, "probability that a beam returns nothing (nan)", ge=0, le=1)
+
+    def problems(self) -> Iterator[Problem]:
+        """The valid range interval must not be empty."""
+        if self.range_min_m >= self.range_max_m:
+            yield Problem(
+                "range_min_m", self.range_min_m, f"a value < range_max_m ({self.range_max_m:g})"
+            )
+
+
+@dataclass(frozen=True)
+class RecordConfig:
+    """``[record]``: what the run keeps."""
+
+    pose_rate_hz: float = param(10.0, "ground-truth pose sampling rate for tables/poses (Hz)", gt=0)
+    messages: bool = param(True, "keep one row per message in tables/messages")
+    tables: bool = param(True, "write tables/*.parquet")

@@ -1,0 +1,145 @@
+"""Planar lidar: beam geometry, exact ray casting, and the sensor's error model.
+
+Conventions follow ``sensor_msgs/LaserScan`` and REP 117: beam ``i`` of ``n`` points at
+``angle_min + i * increment`` in the sensor frame (x forward, counter-clockwise
+positive). A full 360 deg scan has ``increment = 2 pi / n`` and no duplicated first/last
+beam; a narrower field of view spans ``[-fov/2, +fov/2]`` with ``increment = fov/(n-1)``.
+A beam that hits nothing within ``range_max`` reads ``+inf``; a dropped-out beam reads
+``nan``; a hit closer than ``range_min`` reads ``-inf``.
+
+:func:`cast_reference` is the exact float64 brute force over every segment and circle; it
+defines what a correct scan is and serves as the oracle for faster casters.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+FloatArray = npt.NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class ScanGeometry:
+    """Beam layout and range limits of a lidar.
+
+    Attributes:
+        beams: number of beams.
+        fov_rad: field of view (rad), at most 2 pi.
+        range_min_m: minimum valid range (m).
+        range_max_m: maximum range (m).
+    """
+
+    beams: int
+    fov_rad: float
+    range_min_m: float
+    range_max_m: float
+
+    @property
+    def full_circle(self) -> bool:
+        """Whether the scan covers 360 deg (then no beam is duplicated)."""
+        return math.isclose(self.fov_rad, 2 * math.pi)
+
+    @property
+    def angle_min_rad(self) -> float:
+        """Angle of the first beam in the sensor frame (rad)."""
+        return -math.pi if self.full_circle else -self.fov_rad / 2
+
+    @property
+    def angle_increment_rad(self) -> float:
+        """Angle between consecutive beams (rad)."""
+        if self.full_circle:
+            return 2 * math.pi / self.beams
+        return self.fov_rad / (self.beams - 1) if self.beams > 1 else 0.0
+
+    def angles(self) -> FloatArray:
+        """Beam angles in the sensor frame (rad)."""
+        return self.angle_min_rad + self.angle_increment_rad * np.arange(
+            self.beams, dtype=np.float64
+        )
+
+
+def cast_reference(
+    origins: FloatArray,
+    angles: FloatArray,
+    segments: FloatArray,
+    circles: FloatArray,
+    range_max_m: float,
+    exclude: npt.NDArray[np.int64] | None = None,
+) -> FloatArray:
+    """Exact distances from each origin along each beam to the nearest surface.
+
+    Args:
+        origins: (r, 2) ray origins in ``map`` (m).
+        angles: (r, b) absolute beam angles in ``map`` (rad).
+        segments: (s, 4) segments ``x0, y0, x1, y1`` (m).
+        circles: (c, 3) circles ``x, y, radius`` (m), e.g. other robots.
+        range_max_m: rays longer than this read ``inf``.
+        exclude: (r,) index of a circle each origin must not see (its own body), or -1.
+
+    Returns:
+        (r, b) float64 ranges (m); ``inf`` where nothing is hit within ``range_max_m``.
+    """
+    ox = origins[:, 0, None, None]
+    oy = origins[:, 1, None, None]
+    dx = np.cos(angles)[:, :, None]
+    dy = np.sin(angles)[:, :, None]
+    best = np.full(angles.shape, np.inf)
+    if len(segments):
+        x0, y0, x1, y1 = (segments[:, k][None, None, :] for k in range(4))
+        ex, ey = x1 - x0, y1 - y0
+        denom = dx * ey - dy * ex
+        wx, wy = x0 - ox, y0 - oy
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = (wx * ey - wy * ex) / denom
+            u = (wx * dy - wy * dx) / denom
+        hit = (denom != 0) & (t >= 0) & (u >= 0) & (u <= 1)
+        best = np.minimum(best, np.where(hit, t, np.inf).min(axis=2))
+    if len(circles):
+        cx = circles[None, None, :, 0]
+        cy = circles[None, None, :, 1]
+        rad = circles[None, None, :, 2]
+        fx, fy = ox - cx, oy - cy
+        b = fx * dx + fy * dy
+        c = fx * fx + fy * fy - rad * rad
+        disc = b * b - c
+        root = np.sqrt(np.maximum(disc, 0.0))
+        near = -b - root
+        far = -b + root
+        # from outside: the near root; from inside a circle: the exit point
+        t = np.where(c > 0, near, far)
+        ok = (disc >= 0) & (t >= 0)
+        if exclude is not None:
+            own = np.arange(circles.shape[0])[None, None, :] == exclude[:, None, None]
+            ok &= ~own
+        best = np.minimum(best, np.where(ok, t, np.inf).min(axis=2))
+    return np.where(best <= range_max_m, best, np.inf)
+
+
+def apply_sensor_model(
+    ranges: FloatArray,
+    geometry: ScanGeometry,
+    noise_std_m: float,
+    dropout_prob: float,
+    rng: np.random.Generator,
+) -> npt.NDArray[np.float32]:
+    """Add Gaussian range noise and dropouts to exact ranges of one scan.
+
+    The noise is drawn for every beam (hit or not) so the stream's position does not
+    depend on the scene. Noisy hits beyond ``range_max`` read ``inf``, below
+    ``range_min`` read ``-inf`` (REP 117).
+
+    Returns:
+        float32 ranges as published in a LaserScan.
+    """
+    noise = rng.standard_normal(ranges.shape) * noise_std_m
+    drop = rng.random(ranges.shape) < dropout_prob
+    noisy = ranges + noise
+    out = np.where(np.isfinite(ranges), noisy, np.inf)
+    out = np.where(out > geometry.range_max_m, np.inf, out)
+    out = np.where(out < geometry.range_min_m, -np.inf, out)
+    out = np.where(drop, np.nan, out)
+    return out.astype(np.float32)

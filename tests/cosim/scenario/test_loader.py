@@ -1,0 +1,147 @@
+from pathlib import Path
+
+import pytest
+
+import cosim
+from cosim.errors import ConfigError
+from cosim.scenario import dump_scenario, parse_override, preset_names, scenario_from_text
+
+
+def _write(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "s.toml"
+    path.write_text(text)
+    return path
+
+
+def test_every_preset_loads_and_validates():
+    for name in preset_names():
+        scenario = cosim.load_scenario(name)
+        assert scenario.name == name
+
+
+def test_a_scenario_file_fills_missing_keys_with_defaults(tmp_path):
+    scenario = cosim.load_scenario(_write(tmp_path, "[robots]\ncount = 7\n"))
+    assert scenario.robots.count == 7
+    assert scenario.lidar.beams == 360
+    assert scenario.source == str(tmp_path / "s.toml")
+
+
+def test_an_unknown_key_is_rejected_with_a_suggestion(tmp_path):
+    path = _write(tmp_path, "[lidar]\nrate_hzz = 10\n")
+    with pytest.raises(ConfigError) as error:
+        cosim.load_scenario(path)
+    message = str(error.value)
+    assert str(path) in message
+    assert "[lidar] unknown key 'rate_hzz'" in message
+    assert "did you mean 'rate_hz'?" in message
+
+
+def test_an_unknown_section_is_rejected_with_a_suggestion(tmp_path):
+    with pytest.raises(ConfigError, match=r"unknown section \[robot\]; did you mean 'robots'"):
+        cosim.load_scenario(_write(tmp_path, "[robot]\ncount = 2\n"))
+
+
+def test_a_value_of_the_wrong_type_names_key_value_and_expectation(tmp_path):
+    path = _write(tmp_path, '[robots]\ncount = "four"\n')
+    with pytest.raises(ConfigError) as error:
+        cosim.load_scenario(path)
+    assert str(error.value) == f"{path}: [robots] count = 'four': expected an integer > 0"
+
+
+def test_a_negative_rate_is_rejected(tmp_path):
+    path = _write(tmp_path, "[lidar]\nrate_hz = -10\n")
+    with pytest.raises(ConfigError) as error:
+        cosim.load_scenario(path)
+    assert str(error.value) == f"{path}: [lidar] rate_hz = -10: expected a number > 0 and <= 1000"
+
+
+def test_zero_robots_are_rejected(tmp_path):
+    with pytest.raises(ConfigError, match=r"\[robots\] count = 0: expected an integer > 0"):
+        cosim.load_scenario(_write(tmp_path, "[robots]\ncount = 0\n"))
+
+
+def test_a_list_of_the_wrong_length_is_rejected(tmp_path):
+    with pytest.raises(ConfigError, match=r"size_m = \[30.0\]: expected a list of 2 numbers"):
+        cosim.load_scenario(_write(tmp_path, "[world]\nsize_m = [30.0]\n"))
+
+
+def test_a_bound_applies_to_every_element_of_a_list(tmp_path):
+    with pytest.raises(ConfigError, match=r"size_m = \[30.0, -1.0\].*\(every element\)"):
+        cosim.load_scenario(_write(tmp_path, "[world]\nsize_m = [30.0, -1.0]\n"))
+
+
+def test_a_value_outside_a_choice_lists_the_choices(tmp_path):
+    with pytest.raises(ConfigError, match=r"layout = 'rows': expected one of 'random', 'all_rows'"):
+        cosim.load_scenario(_write(tmp_path, '[world]\nlayout = "rows"\n'))
+
+
+def test_cross_field_problems_name_the_key(tmp_path):
+    with pytest.raises(
+        ConfigError, match=r"\[lidar\] range_min_m = 12.0: expected a value < range_max_m"
+    ):
+        cosim.load_scenario(_write(tmp_path, "[lidar]\nrange_min_m = 12.0\n"))
+
+
+def test_malformed_toml_is_reported_with_the_file(tmp_path):
+    path = _write(tmp_path, "[robots\ncount = 3\n")
+    with pytest.raises(ConfigError, match=rf"{path}: malformed TOML"):
+        cosim.load_scenario(path)
+
+
+def test_a_missing_file_is_reported(tmp_path):
+    with pytest.raises(ConfigError, match="scenario file not found"):
+        cosim.load_scenario(tmp_path / "nope.toml")
+
+
+def test_an_unknown_preset_suggests_the_nearest_one():
+    with pytest.raises(ConfigError, match="did you mean 'warehouse-random'"):
+        cosim.load_scenario("warehouse-randon")
+
+
+def test_overrides_are_type_checked_and_name_their_origin():
+    with pytest.raises(ConfigError) as error:
+        cosim.load_scenario("warehouse-random", {"lidar.beams": 2.5})
+    assert str(error.value) == "--set lidar.beams: [lidar] beams = 2.5: expected an integer >= 0"
+
+
+def test_overrides_replace_file_values():
+    scenario = cosim.load_scenario(
+        "warehouse-random", {"robots.count": 9, "world.layout": "all_rows"}
+    )
+    assert scenario.robots.count == 9
+    assert scenario.world.layout == "all_rows"
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        ("lidar.rate_hz=20", ("lidar.rate_hz", 20)),
+        ("world.layout=all_rows", ("world.layout", "all_rows")),
+        ('world.layout="all_rows"', ("world.layout", "all_rows")),
+        ("world.size_m=[10, 20.5]", ("world.size_m", [10, 20.5])),
+        ("record.messages=false", ("record.messages", False)),
+    ],
+)
+def test_override_values_are_read_as_toml(text, expected):
+    assert parse_override(text) == expected
+
+
+@pytest.mark.parametrize("text", ["lidar", "rate_hz=3", "a.b.c=1", ".x=1"])
+def test_malformed_overrides_are_rejected(text):
+    with pytest.raises(ConfigError, match=r"expected section\.key=value"):
+        parse_override(text)
+
+
+def test_the_resolved_dump_loads_back_to_an_equal_scenario():
+    scenario = cosim.load_scenario(
+        "warehouse-random",
+        {
+            "robots.placement": "explicit",
+            "robots.count": 2,
+            "robots.positions": [[2.0, 3.0, 0.5], [5.0, 6.0, -1.0]],
+            "scenario.name": 'a "quoted" name',
+        },
+    )
+    text = dump_scenario(scenario)
+    assert scenario_from_text(text, "dump") == scenario
+    assert "[robots]" in text and "[lidar]" in text

@@ -1,0 +1,120 @@
+from collections.abc import Sequence
+
+import numpy as np
+
+from cosim.bus import Bus, Envelope
+from cosim.hosts import HostId
+from cosim.kernel import Kernel, Stage
+from cosim.link import DeliveryStatus, Transfer
+from cosim.messages import Message, Twist
+from cosim.records import Recorder
+from cosim.timebase import period_ns
+
+A, B, C = HostId("a"), HostId("b"), HostId("c")
+
+
+class FixedDelayLink:
+    """A test link: every message arrives a fixed delay later; drops towards 'c'."""
+
+    def __init__(self, delay_ns: int) -> None:
+        self.delay_ns = delay_ns
+        self.calls: list[tuple[int, HostId, tuple[HostId, ...], int]] = []
+
+    def transmit(
+        self, t_ns: int, src: HostId, dsts: Sequence[HostId], nbytes: int, topic: str
+    ) -> Sequence[Transfer]:
+        self.calls.append((t_ns, src, tuple(dsts), nbytes))
+        return [
+            Transfer(d, DeliveryStatus.LOST, None)
+            if d == C
+            else Transfer(d, DeliveryStatus.DELIVERED, t_ns + self.delay_ns)
+            for d in dsts
+        ]
+
+
+def _collect(into: list[tuple[int, Message, Envelope]], kernel: Kernel):
+    def callback(message: Message, envelope: Envelope) -> None:
+        into.append((kernel.now_ns, message, envelope))
+
+    return callback
+
+
+def test_a_10_hz_publisher_is_delivered_at_exactly_k_times_100_ms_on_its_host():
+    kernel = Kernel()
+    bus = Bus(kernel)
+    got: list[tuple[int, Message, Envelope]] = []
+    bus.subscribe("/cmd", A, _collect(got, kernel))
+    kernel.every(
+        period_ns(10), lambda now: bus.publish("/cmd", Twist(1.0, 0.0), A), stage=Stage.CONTROL
+    )
+    kernel.run(2_000_000_000)
+    assert [t for t, _, _ in got] == [k * 100_000_000 for k in range(20)]
+    assert all(env.t_sent_ns == env.t_recv_ns == t for t, _, env in got)
+
+
+def test_a_remote_subscriber_receives_when_the_link_says():
+    kernel = Kernel()
+    link = FixedDelayLink(5_000_000)
+    bus = Bus(kernel, link)
+    got: list[tuple[int, Message, Envelope]] = []
+    bus.subscribe("/cmd", B, _collect(got, kernel))
+    kernel.every(
+        period_ns(10), lambda now: bus.publish("/cmd", Twist(0.5, 0.1), A), stage=Stage.CONTROL
+    )
+    kernel.run(1_000_000_000)
+    assert [t for t, _, _ in got] == [k * 100_000_000 + 5_000_000 for k in range(10)]
+    assert got[0][2] == Envelope("/cmd", A, 0, 5_000_000)
+
+
+def test_one_transmission_reaches_every_remote_host_once_however_many_subscribers():
+    kernel = Kernel()
+    link = FixedDelayLink(0)
+    bus = Bus(kernel, link)
+    got: list[tuple[int, Message, Envelope]] = []
+    for _ in range(3):
+        bus.subscribe("/t", B, _collect(got, kernel))
+    bus.subscribe("/t", C, _collect(got, kernel))
+    bus.publish("/t", Twist(0.0, 0.0), A)
+    kernel.run(1)
+    assert link.calls == [(0, A, (B, C), Twist(0.0, 0.0).size_bytes())]
+    assert len(got) == 3  # three callbacks on b, none on c (lost)
+
+
+def test_local_subscribers_are_called_at_once_in_subscription_order():
+    kernel = Kernel()
+    bus = Bus(kernel)
+    order: list[str] = []
+    bus.subscribe("/t", A, lambda m, e: order.append("first"))
+    bus.subscribe("/t", A, lambda m, e: order.append("second"))
+    bus.publish("/t", Twist(0.0, 0.0), A)
+    assert order == ["first", "second"]
+
+
+def test_the_recorder_sees_every_delivery_and_drop_with_exact_times():
+    kernel = Kernel()
+    recorder = Recorder()
+    bus = Bus(kernel, FixedDelayLink(2_500_000), tap=recorder)
+    bus.subscribe("/t", A, lambda m, e: None)
+    bus.subscribe("/t", B, lambda m, e: None)
+    bus.subscribe("/t", C, lambda m, e: None)
+    kernel.at(1_000_000, lambda: bus.publish("/t", Twist(0.0, 0.0), A))
+    kernel.run(10_000_000)
+    frame = recorder.messages_frame().sort_values("dst_host").reset_index(drop=True)
+    assert list(frame["dst_host"]) == ["a", "b", "c"]
+    assert list(frame["status"]) == ["delivered", "delivered", "lost"]
+    assert list(frame["t_sent_ns"]) == [1_000_000] * 3
+    assert frame["t_recv_ns"][0] == 1_000_000
+    assert frame["t_recv_ns"][1] == 3_500_000
+    assert frame["t_recv_ns"].isna()[2]
+    assert np.isnan(frame["t_recv_s"][2])
+    assert set(frame["bytes"]) == {52}
+    assert recorder.counts["lost"] == 1
+
+
+def test_a_message_without_subscribers_goes_nowhere():
+    kernel = Kernel()
+    recorder = Recorder()
+    bus = Bus(kernel, tap=recorder)
+    bus.publish("/nobody", Twist(0.0, 0.0), A)
+    assert len(recorder.messages_frame()) == 0
+    assert bus.published == 1

@@ -1,0 +1,188 @@
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from cosim.cli import main
+
+SMALL = [
+    "--set",
+    "world.size_m=[12.0, 12.0]",
+    "--set",
+    "world.shelf_count=4",
+    "--set",
+    "robots.count=3",
+    "--set",
+    "lidar.beams=90",
+]
+
+
+def cosim_cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "cosim", *args], capture_output=True, text=True, cwd=cwd, timeout=120
+    )
+
+
+def test_run_writes_the_contracted_folder_and_says_where(tmp_path):
+    out = tmp_path / "run"
+    done = cosim_cli("run", "warehouse-random", "--out", str(out), "--duration-s", "2", *SMALL)
+    assert done.returncode == 0, done.stderr
+    assert f"results: {out}/" in done.stdout
+    assert "real time" in done.stdout
+    summary = json.loads((out / "summary.json").read_text())
+    for key in (
+        "scenario",
+        "seed",
+        "version",
+        "sim_time_s",
+        "wall_time_s",
+        "real_time_factor",
+        "robots",
+        "events",
+    ):
+        assert key in summary
+    assert summary["sim_time_s"] == 2.0
+    assert summary["robots"] == 3
+    assert (out / "scenario.toml").read_text().startswith("# resolved from preset warehouse-random")
+    poses = pd.read_parquet(out / "tables" / "poses.parquet")
+    assert list(poses.columns) == ["t_s", "robot", "x_m", "y_m", "yaw_rad", "v_mps", "w_radps"]
+    messages = pd.read_parquet(out / "tables" / "messages.parquet")
+    assert list(messages.columns[:7]) == [
+        "t_sent_s",
+        "t_recv_s",
+        "src_host",
+        "dst_host",
+        "topic",
+        "bytes",
+        "status",
+    ]
+    events = pd.read_parquet(out / "tables" / "events.parquet")
+    assert list(events.columns[:4]) == ["t_s", "source", "kind", "detail"]
+
+
+def test_the_resolved_scenario_reproduces_the_run(tmp_path):
+    first, second = tmp_path / "a", tmp_path / "b"
+    assert (
+        cosim_cli(
+            "run",
+            "warehouse-random",
+            "--out",
+            str(first),
+            "--seed",
+            "5",
+            "--duration-s",
+            "1.5",
+            "--quiet",
+            *SMALL,
+        ).returncode
+        == 0
+    )
+    assert (
+        cosim_cli("run", str(first / "scenario.toml"), "--out", str(second), "--quiet").returncode
+        == 0
+    )
+    for table in ("poses", "messages", "events"):
+        pd.testing.assert_frame_equal(
+            pd.read_parquet(first / "tables" / f"{table}.parquet"),
+            pd.read_parquet(second / "tables" / f"{table}.parquet"),
+        )
+
+
+def test_run_refuses_a_non_empty_output_folder_unless_forced(tmp_path):
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / "notes.txt").write_text("keep me")
+    refused = cosim_cli("run", "warehouse-random", "--out", str(out), "--duration-s", "0.5", *SMALL)
+    assert refused.returncode == 2
+    assert "not empty" in refused.stderr and "--force" in refused.stderr
+    forced = cosim_cli(
+        "run",
+        "warehouse-random",
+        "--out",
+        str(out),
+        "--duration-s",
+        "0.5",
+        "--force",
+        "--quiet",
+        *SMALL,
+    )
+    assert forced.returncode == 0, forced.stderr
+    assert forced.stdout == ""
+    assert (out / "notes.txt").read_text() == "keep me"
+    assert (out / "summary.json").exists()
+
+
+@pytest.mark.parametrize(
+    ("content", "fragment"),
+    [
+        ("[lidar]\nrate_hzz = 10\n", "unknown key 'rate_hzz'; did you mean 'rate_hz'?"),
+        ('[robots]\ncount = "4"\n', "[robots] count = '4': expected an integer > 0"),
+        ("[lidar]\nrate_hz = -1\n", "[lidar] rate_hz = -1: expected a number > 0"),
+        ("[robots]\ncount = 0\n", "[robots] count = 0: expected an integer > 0"),
+        ("[robots\ncount = 0\n", "malformed TOML"),
+    ],
+)
+def test_invalid_scenario_files_exit_2_with_one_line_naming_the_key(tmp_path, content, fragment):
+    path = tmp_path / "bad.toml"
+    path.write_text(content)
+    done = cosim_cli("run", str(path), "--out", str(tmp_path / "out"))
+    assert done.returncode == 2
+    assert done.stderr.count("\n") == 1, done.stderr
+    assert str(path) in done.stderr
+    assert fragment in done.stderr
+    assert "Traceback" not in done.stderr
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize(
+    ("args", "fragment"),
+    [
+        (["check", "missing.toml"], "missing.toml: scenario file not found"),
+        (["check", "warehouse-randomm"], "did you mean 'warehouse-random'"),
+        (
+            ["check", "warehouse-random", "--set", "lidar.beams=-3"],
+            "--set lidar.beams: [lidar] beams = -3: expected an integer >= 0",
+        ),
+        (["check", "warehouse-random", "--set", "nonsense"], "expected section.key=value"),
+        (["run", "warehouse-random", "--seed", "-1"], "expected an integer >= 0"),
+        (["run", "warehouse-random", "--duration-s", "0"], "not a finite number > 0"),
+        (["run", "warehouse-random", "--set", "world.shelf_count=400"], "world.shelf_count = 400"),
+        (["frobnicate"], "invalid choice"),
+    ],
+)
+def test_invalid_command_lines_exit_2_with_one_line(tmp_path, args, fragment):
+    done = cosim_cli(*args, cwd=tmp_path)
+    assert done.returncode == 2
+    assert fragment in done.stderr
+    assert done.stderr.count("\n") == 1, done.stderr
+
+
+def test_check_validates_without_running(capsys):
+    assert main(["check", "warehouse-random", "--set", "robots.count=6"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("ok: warehouse-random (preset warehouse-random): 6 robots")
+
+
+def test_check_can_print_the_resolved_scenario(capsys):
+    assert main(["check", "warehouse-random", "--print"]) == 0
+    assert "[lidar]\nbeams = 360" in capsys.readouterr().out
+
+
+def test_scenarios_lists_every_preset_on_one_line_each(capsys):
+    assert main(["scenarios"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert any(line.startswith("warehouse-random ") for line in lines)
+    assert all(len(line.split()) > 1 for line in lines)
+
+
+def test_help_explains_every_command():
+    done = cosim_cli("--help")
+    assert done.returncode == 0
+    for command in ("run", "check", "scenarios"):
+        assert command in done.stdout
+    run_help = cosim_cli("run", "--help").stdout
+    for flag in ("--out", "--seed", "--duration-s", "--set", "--quiet", "--force"):
+        assert flag in run_help
