@@ -2,15 +2,18 @@
 
 Each robot is a host named after it. The adapter subscribes ``/<robot>/cmd_vel`` on the
 robot's host and, at ``robots.control_hz`` in the PHYSICS stage, advances all robots in
-one vectorized step and publishes ``/<robot>/odom``. The ``odom`` frame starts aligned
+one vectorized step and publishes ``/<robot>/odom``. Before a step is committed, motion
+guards (the collision adapter) may hold robots back. The ``odom`` frame starts aligned
 with ``map`` (each robot is told its start pose, as an initial pose is given to a
-localizer), so without drift odometry equals ground truth.
+localizer); with ``odometry.drift`` > 0 it drifts away from ground truth.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any, ClassVar
+
+import numpy as np
 
 from adapters.naming import robot_name, topic
 from cosim.adapter import RunContext
@@ -18,9 +21,14 @@ from cosim.bus import Envelope
 from cosim.hosts import HostKind
 from cosim.kernel import Stage
 from cosim.messages import Message, Odometry, Twist
+from cosim.rng import BlockDraws
 from cosim.timebase import NS_PER_S, period_ns
-from models.kinematics import DriveLimits, FleetState
+from models.kinematics import DriveLimits, FleetState, Motion
+from models.odometry import advance, drift_increments
 from models.world import Warehouse
+
+MotionGuard = Callable[[int, Motion], None]
+"""Called with (now in ns, proposed motion) before a step is committed; may hold robots."""
 
 
 def drive_limits(run: RunContext) -> DriveLimits:
@@ -49,7 +57,17 @@ class FleetAdapter:
         self.limits = drive_limits(run)
         self.hosts = [run.add_host(name, HostKind.ROBOT) for name in names]
         self.period_ns = period_ns(robots.control_hz)
+        self.dt_s = self.period_ns / NS_PER_S
+        self.guards: list[MotionGuard] = []
+        self.drift = run.scenario.odometry.drift
+        self.odom = world.starts.astype(float).copy()
+        self._noise = BlockDraws([run.rng.stream(f"odometry/{n}") for n in names], width=2)
         run.provide(self.state)
+        run.provide(self)
+
+    def add_guard(self, guard: MotionGuard) -> None:
+        """Let ``guard`` inspect (and hold back) every proposed step before it is committed."""
+        self.guards.append(guard)
 
     def start(self, run: RunContext) -> None:
         """Subscribe to every robot's cmd_vel and start the physics tick."""
@@ -58,7 +76,7 @@ class FleetAdapter:
         self._odom_topics = [topic(name, "odom") for name in self.state.names]
         run.kernel.every(self.period_ns, lambda now: self._tick(run, now), stage=Stage.PHYSICS)
 
-    def _on_cmd(self, index: int) -> Any:
+    def _on_cmd(self, index: int) -> Callable[[Message, Envelope], None]:
         state = self.state
 
         def on_cmd(message: Message, _envelope: Envelope) -> None:
@@ -70,31 +88,41 @@ class FleetAdapter:
 
     def _tick(self, run: RunContext, now_ns: int) -> None:
         if now_ns > 0:
-            self.state.step(self.limits, self.period_ns / NS_PER_S)
+            state = self.state
+            motion = state.propose(self.limits, self.dt_s)
+            for guard in self.guards:
+                guard(now_ns, motion)
+            state.commit(motion)
+            # the arc each robot drove: guards zero the velocity of robots they hold
+            self._integrate_odometry(motion.v * self.dt_s, motion.w * self.dt_s)
         self._publish_odometry(run, now_ns)
+
+    def _integrate_odometry(self, ds: np.ndarray, dtheta: np.ndarray) -> None:
+        if self.drift > 0:
+            ds, dtheta = drift_increments(ds, dtheta, self.drift, self._noise.draw())
+        x, y, yaw = advance(self.odom[:, 0], self.odom[:, 1], self.odom[:, 2], ds, dtheta)
+        self.odom = np.stack([x, y, yaw], axis=1)
 
     def _publish_odometry(self, run: RunContext, now_ns: int) -> None:
         state = self.state
+        odom = self.odom.tolist()
+        v = state.v.tolist()
+        w = state.w.tolist()
         publish = run.bus.publish
         for i, host in enumerate(self.hosts):
+            x, y, yaw = odom[i]
             publish(
                 self._odom_topics[i],
-                Odometry(
-                    now_ns,
-                    "odom",
-                    "base_link",
-                    float(state.x[i]),
-                    float(state.y[i]),
-                    float(state.yaw[i]),
-                    float(state.v[i]),
-                    float(state.w[i]),
-                ),
+                Odometry(now_ns, "odom", "base_link", x, y, yaw, v[i], w[i]),
                 host,
             )
 
     def finish(self, run: RunContext) -> Mapping[str, Any]:
-        """Robots and distance driven."""
+        """Robots, distance driven and the final odometry error."""
+        state = self.state
+        error = np.hypot(self.odom[:, 0] - state.x, self.odom[:, 1] - state.y)
         return {
-            "robots": len(self.state),
-            "distance_m": round(float(self.state.distance_m.sum()), 6),
+            "robots": len(state),
+            "distance_m": round(float(state.distance_m.sum()), 6),
+            "odometry_error_m_mean": round(float(error.mean()), 6),
         }

@@ -33,6 +33,9 @@ SIGHT_MARGIN_M = 0.15
 """Extra clearance around the straight path to a waypoint (m)."""
 GOAL_TIMEOUT_S = 60.0
 """A waypoint not reached in this time is abandoned (s)."""
+STALL_S = 3.0
+"""A robot that has not moved ``STALL_M`` in this time (blocked) abandons its waypoint (s)."""
+STALL_M = 0.1
 
 
 class WaypointsAdapter:
@@ -56,6 +59,8 @@ class WaypointsAdapter:
         self.yaw = fleet.yaw.copy()
         self.goal = np.full((count, 2), np.nan)
         self.goal_deadline_ns = np.zeros(count, dtype=np.int64)
+        self.progress_xy = self.pose.copy()
+        self.progress_ns = np.zeros(count, dtype=np.int64)
         obstacles = (
             shapely.union_all([box(*b) for b in self.world.shelves])
             if len(self.world.shelves)
@@ -122,15 +127,22 @@ class WaypointsAdapter:
             self.max_speed_mps,
             self.gains,
         )
+        moved = np.hypot(*(self.pose - self.progress_xy).T) > STALL_M
+        self.progress_xy[moved] = self.pose[moved]
+        self.progress_ns[moved] = now_ns
+        stalled = now_ns - self.progress_ns >= s_to_ns(STALL_S)
         expired = now_ns >= self.goal_deadline_ns
-        for due in np.flatnonzero(arrived | expired):
+        for due in np.flatnonzero(arrived | expired | stalled):
             index = int(due)
             if arrived[index]:
                 self.reached += 1
                 run.recorder.event(now_ns, self.names[index], "arrived", "")
             else:
                 self.abandoned += 1
-                run.recorder.event(now_ns, self.names[index], "abandoned", "goal timeout")
+                why = "blocked" if stalled[index] else "goal timeout"
+                run.recorder.event(now_ns, self.names[index], "abandoned", why)
+            self.progress_xy[index] = self.pose[index]
+            self.progress_ns[index] = now_ns
             self._new_goal(run, index)
         publish = run.bus.publish
         for index, host in enumerate(self.hosts):

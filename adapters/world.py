@@ -8,14 +8,21 @@ from typing import Any, ClassVar
 from cosim.adapter import RunContext
 from cosim.errors import ScenarioError
 from cosim.hosts import BASE_HOST, HostKind
+from cosim.scenario.model import Scenario
 from models.errors import ModelError
+from models.obstacles import DynamicObstacles
 from models.world import Warehouse, WarehouseSpec, generate_warehouse
 
 
 def warehouse_spec(run: RunContext) -> WarehouseSpec:
     """The model parameters of the scenario's world and fleet placement."""
-    world = run.scenario.world
-    robots = run.scenario.robots
+    return spec_from_scenario(run.scenario)
+
+
+def spec_from_scenario(scenario: Scenario) -> WarehouseSpec:
+    """The model parameters of a scenario's world and fleet placement (no run needed)."""
+    world = scenario.world
+    robots = scenario.robots
     return WarehouseSpec(
         size_m=world.size_m,
         layout=world.layout,
@@ -28,6 +35,7 @@ def warehouse_spec(run: RunContext) -> WarehouseSpec:
         robot_radius_m=robots.radius_m,
         placement=robots.placement,
         positions=robots.positions,
+        obstacles=world.obstacles,
     )
 
 
@@ -55,6 +63,7 @@ class WorldAdapter:
         self.warehouse = build_warehouse(run)
         run.add_host(BASE_HOST, HostKind.BASE)
         run.provide(self.warehouse)
+        run.provide(DynamicObstacles())
 
     def start(self, run: RunContext) -> None:
         """Record the world's size in the events table."""

@@ -5,10 +5,17 @@ from __future__ import annotations
 import statistics
 import time
 from collections.abc import Callable
-from typing import Any
+from typing import Any, ClassVar
+
+import numpy as np
+from lidar_bench import lidar_rays_per_second
 
 import cosim
+from cosim.adapter import RunContext
 from cosim.kernel import Kernel, Stage
+from cosim.registry import AdapterRegistry
+from cosim.runner import execute
+from models.kinematics import FleetState
 
 Result = dict[str, Any]
 
@@ -64,7 +71,96 @@ def kernel_periodic_1000(repeat: int) -> Result:
     }
 
 
+class SineDriver:
+    """Bench-only robot software: sets every robot's command directly (no bus), weaving."""
+
+    name: ClassVar[str] = "sine_driver"
+    requires: ClassVar[tuple[str, ...]] = ("fleet",)
+
+    def __init__(self, run: RunContext) -> None:
+        self.fleet = run.service(FleetState)
+        self.phase = np.linspace(0.0, 2 * np.pi, len(self.fleet), endpoint=False)
+
+    def start(self, run: RunContext) -> None:
+        def drive(now: int) -> None:
+            t = now / 1e9
+            self.fleet.v_cmd[:] = 0.8
+            self.fleet.w_cmd[:] = 0.6 * np.sin(t / 2.0 + self.phase)
+
+        run.kernel.every(50_000_000, drive, stage=Stage.CONTROL)
+
+    def finish(self, run: RunContext) -> dict[str, Any]:
+        return {}
+
+
+def _rtf_runs(
+    scenario: cosim.Scenario,
+    repeat: int,
+    names: list[str] | None = None,
+    registry: AdapterRegistry | None = None,
+) -> Result:
+    walls, summaries = [], []
+    execute(scenario.with_duration(1.0), names=names, registry=registry)  # JIT caches warm
+    for seed in range(1, repeat + 1):
+        result = execute(scenario.with_seed(seed), names=names, registry=registry)
+        walls.append(result.summary["wall_time_s"])
+        summaries.append(result.summary)
+    wall = statistics.median(walls)
+    sim = scenario.scenario.duration_s
+    last = summaries[-1]
+    return {
+        "sim_time_s": sim,
+        "robots": last["robots"],
+        "wall_time_s_median": round(wall, 4),
+        "real_time_factor_median": round(sim / wall, 2),
+        "wall_time_s_all": walls,
+        "collisions_last": last.get("collisions"),
+        "distance_m_last": last.get("distance_m"),
+        "repeat": repeat,
+    }
+
+
+def fleet50_physics(repeat: int) -> Result:
+    """fleet50: kinematics + 10 Hz lidar + collision checks; robots weave (no bus driver)."""
+    scenario = cosim.load_scenario("fleet50", {"scenario.duration_s": 60.0})
+    registry = AdapterRegistry.from_entry_points().with_adapter(SineDriver)
+    names = ["world", "fleet", "collisions", "lidar", "poses", "sine_driver"]
+    return {"adapters": names, **_rtf_runs(scenario, repeat, names, registry)}
+
+
+def fleet50_wander(repeat: int) -> Result:
+    """fleet50 preset with the wander driver: physics plus robot software over the bus."""
+    scenario = cosim.load_scenario(
+        "fleet50", {"scenario.duration_s": 60.0, "robots.driver": "wander"}
+    )
+    return {"driver": "wander", **_rtf_runs(scenario, repeat)}
+
+
+def fleet1000_wander(repeat: int) -> Result:
+    """1,000 robots in a 100 m x 100 m hall with racks, wander driver, same sensors."""
+    scenario = cosim.load_scenario(
+        "fleet50",
+        {
+            "scenario.duration_s": 10.0,
+            "world.size_m": [100.0, 100.0],
+            "world.shelf_count": 600,
+            "robots.count": 1000,
+            "robots.driver": "wander",
+        },
+    )
+    return {"hall_m": [100.0, 100.0], "shelves": 600, **_rtf_runs(scenario, max(1, repeat - 2))}
+
+
+def lidar(repeat: int) -> Result:
+    """Grid ray caster throughput, one core (see bench/lidar_bench.py)."""
+    return lidar_rays_per_second(max(repeat, 20))
+
+
 SUITES: dict[str, Callable[[int], Result]] = {
     "warehouse_random_60s": warehouse_random_60s,
     "kernel_periodic_1000": kernel_periodic_1000,
+    "lidar": lidar,
+    "fleet50_physics": fleet50_physics,
+    "fleet50_wander": fleet50_wander,
+    "fleet1000_wander": fleet1000_wander,
 }

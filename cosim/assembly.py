@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 from cosim.adapter import Adapter, RunContext
 from cosim.bus import Bus
+from cosim.errors import ConfigError
 from cosim.kernel import Kernel
 from cosim.records import Recorder
 from cosim.registry import AdapterRegistry
@@ -14,11 +15,21 @@ from cosim.scenario.model import Scenario
 
 
 def adapter_names(scenario: Scenario) -> list[str]:
-    """The adapters a scenario runs, before requirements are resolved."""
-    names = ["world", "fleet"]
+    """The adapters a scenario runs, before requirements are resolved.
+
+    Raises:
+        ConfigError: for combinations that cannot work (a lidar-driven behaviour without
+            a lidar).
+    """
+    if scenario.robots.driver == "wander" and scenario.lidar.beams == 0:
+        raise ConfigError(
+            f"{scenario.source}: [robots] driver = 'wander': expected lidar.beams > 0 "
+            "(wander steers by the lidar)"
+        )
+    names = ["world", "fleet", "collisions"]
     if scenario.lidar.beams > 0:
         names.append("lidar")
-    names += ["waypoints", "poses"]
+    names += [scenario.robots.driver, "poses"]
     names += [name for name in scenario.scenario.adapters if name not in names]
     return names
 

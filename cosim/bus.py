@@ -11,8 +11,7 @@ recorder).
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
-from typing import Protocol
+from typing import NamedTuple, Protocol
 
 import simpy
 
@@ -22,9 +21,8 @@ from cosim.link import DeliveryStatus, IdealLink, Link, Transfer
 from cosim.messages import Message
 
 
-@dataclass(frozen=True, slots=True)
-class Envelope:
-    """What a subscriber learns about a message besides its content.
+class Envelope(NamedTuple):
+    """What a subscriber learns about a message besides its content (immutable).
 
     Attributes:
         topic: topic name.
@@ -59,9 +57,8 @@ class BusTap(Protocol):
         ...
 
 
-@dataclass(slots=True)
-class _Subscribers:
-    by_host: dict[HostId, list[Callback]]
+Route = tuple[tuple[Callback, ...], tuple[HostId, ...]]
+"""For one topic and publishing host: the local callbacks and the remote hosts."""
 
 
 class Bus:
@@ -77,38 +74,50 @@ class Bus:
         self.kernel = kernel
         self.link: Link = link if link is not None else IdealLink()
         self.tap = tap
-        self._topics: dict[str, _Subscribers] = {}
+        self._topics: dict[str, dict[HostId, list[Callback]]] = {}
+        self._routes: dict[tuple[str, HostId], Route] = {}
         self.published = 0
 
     def subscribe(self, topic: str, host: HostId, callback: Callback) -> None:
         """Call ``callback(message, envelope)`` for every message on ``topic`` reaching ``host``."""
-        subs = self._topics.setdefault(topic, _Subscribers({}))
-        subs.by_host.setdefault(host, []).append(callback)
+        self._topics.setdefault(topic, {}).setdefault(host, []).append(callback)
+        self._routes.clear()
 
     def subscribers(self, topic: str) -> list[HostId]:
         """Hosts with at least one subscriber on ``topic``, in subscription order."""
-        subs = self._topics.get(topic)
-        return list(subs.by_host) if subs else []
+        return list(self._topics.get(topic, {}))
+
+    def _route(self, topic: str, src: HostId) -> Route:
+        by_host = self._topics.get(topic, {})
+        local = tuple(by_host.get(src, ()))
+        remote = tuple(host for host in by_host if host != src)
+        route = (local, remote)
+        self._routes[(topic, src)] = route
+        return route
 
     def publish(self, topic: str, message: Message, src: HostId) -> None:
-        """Publish ``message`` on ``topic`` from host ``src`` at the current time."""
+        """Publish ``message`` on ``topic`` from host ``src`` at the current time.
+
+        Remote hosts are handed to the link first (their deliveries are scheduled), then
+        local subscribers are called at once, in subscription order.
+        """
         self.published += 1
-        subs = self._topics.get(topic)
-        if subs is None:
+        route = self._routes.get((topic, src))
+        if route is None:
+            route = self._route(topic, src)
+        local, remote = route
+        if not local and not remote:
             return
-        now = self.kernel.now_ns
+        now = int(self.kernel.env.now)
         nbytes = message.size_bytes()
-        tap = self.tap
-        remote = [host for host in subs.by_host if host != src]
-        local = subs.by_host.get(src)
         if remote:
             for transfer in self.link.transmit(now, src, remote, nbytes, topic):
-                self._dispatch(topic, message, src, now, nbytes, transfer, subs)
-        if local is not None:
-            if tap is not None:
-                tap.on_transfer(now, now, src, src, topic, nbytes, DeliveryStatus.DELIVERED)
+                self._dispatch(topic, message, src, now, nbytes, transfer)
+        if local:
+            if self.tap is not None:
+                self.tap.on_transfer(now, now, src, src, topic, nbytes, DeliveryStatus.DELIVERED)
             envelope = Envelope(topic, src, now, now)
-            for callback in list(local):
+            for callback in local:
                 callback(message, envelope)
 
     def _dispatch(
@@ -119,7 +128,6 @@ class Bus:
         t_sent_ns: int,
         nbytes: int,
         transfer: Transfer,
-        subs: _Subscribers,
     ) -> None:
         if self.tap is not None:
             self.tap.on_transfer(
@@ -128,10 +136,12 @@ class Bus:
         if transfer.status is not DeliveryStatus.DELIVERED or transfer.t_recv_ns is None:
             return
         envelope = Envelope(topic, src, t_sent_ns, transfer.t_recv_ns)
-        callbacks = subs.by_host[transfer.dst]
+        by_host = self._topics[topic]
+        dst = transfer.dst
 
         def deliver(_event: simpy.Event) -> None:
-            for callback in list(callbacks):
+            # subscribers as they are on arrival, as a ROS subscription would be
+            for callback in tuple(by_host.get(dst, ())):
                 callback(message, envelope)
 
         delay = transfer.t_recv_ns - t_sent_ns

@@ -102,10 +102,32 @@ def build_parser() -> argparse.ArgumentParser:
     check = commands.add_parser(
         "check",
         help="validate a scenario without running it",
-        description="Load and validate a scenario; print a one-line description of it.",
+        description=(
+            "Load and validate a scenario, build its world and adapters without running "
+            "them, and print a one-line description."
+        ),
     )
     _scenario_argument(check)
     check.add_argument("--print", action="store_true", help="print the fully resolved scenario")
+
+    world = commands.add_parser(
+        "world",
+        help="write a scenario's world as a picture, a ROS map and a Gazebo world",
+        description=(
+            "Build the scenario's world (the same one `cosim run` builds for that seed) and "
+            "write it as a PNG picture, a ROS map_server map (PGM + YAML, loadable by "
+            "nav2_map_server) and/or a Gazebo SDF world. Without an output flag, print a "
+            "description of the world."
+        ),
+    )
+    _scenario_argument(world)
+    world.add_argument("--seed", type=_non_negative_int, help="override scenario.seed")
+    world.add_argument("--png", type=Path, metavar="F.png", help="write a picture of the world")
+    world.add_argument("--map", type=Path, metavar="F.yaml", help="write a map_server map")
+    world.add_argument("--sdf", type=Path, metavar="F.sdf", help="write a Gazebo SDF world")
+    world.add_argument(
+        "--resolution-m", type=_positive_float, default=0.05, help="map resolution (m/cell)"
+    )
 
     commands.add_parser(
         "scenarios",
@@ -160,12 +182,35 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
+    from cosim.assembly import assemble
     from cosim.scenario import dump_scenario
 
     scenario = _load(args)
+    assemble(scenario)  # builds the world and every adapter: impossible requests fail here
     print(f"ok: {_describe(scenario)}")
     if args.print:
         print(dump_scenario(scenario), end="")
+    return EXIT_OK
+
+
+def _cmd_world(args: argparse.Namespace) -> int:
+    from cosim.worldfiles import scenario_warehouse, world_command
+
+    scenario = _load(args)
+    if args.seed is not None:
+        scenario = scenario.with_seed(args.seed)
+    if not (args.png or args.map or args.sdf):
+        world = scenario_warehouse(scenario)
+        print(
+            f"{_describe(scenario)}: {len(world.shelves)} shelves, "
+            f"{len(world.obstacles)} extra obstacles, dock depth {world.dock_depth_m:.2f} m "
+            "(write files with --png, --map, --sdf)"
+        )
+        return EXIT_OK
+    for path in world_command(
+        scenario, png=args.png, map_yaml=args.map, sdf=args.sdf, resolution_m=args.resolution_m
+    ):
+        print(f"wrote {path}")
     return EXIT_OK
 
 
@@ -177,7 +222,12 @@ def _cmd_scenarios(_args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-COMMANDS = {"run": _cmd_run, "check": _cmd_check, "scenarios": _cmd_scenarios}
+COMMANDS = {
+    "run": _cmd_run,
+    "check": _cmd_check,
+    "world": _cmd_world,
+    "scenarios": _cmd_scenarios,
+}
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -13,6 +13,7 @@ Frames follow REP 105: ``map`` (fixed world frame), ``odom`` (drifting, continuo
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import ClassVar
 
 import numpy as np
@@ -41,6 +42,22 @@ def _doubles(offset: int, count: int) -> int:
 
 def _float_seq(offset: int, count: int) -> int:
     return _align(offset, 4) + 4 + 4 * count
+
+
+@lru_cache(maxsize=4096)
+def _odometry_size(frame_id: str, child_frame_id: str) -> int:
+    offset = _header(0, frame_id)
+    offset = _string(offset, child_frame_id)
+    offset = _doubles(offset, 7 + 36)
+    return _ENCAPSULATION + _doubles(offset, 6 + 36)
+
+
+@lru_cache(maxsize=4096)
+def _scan_size(frame_id: str, beams: int) -> int:
+    offset = _header(0, frame_id)
+    offset = _align(offset, 4) + 7 * 4
+    offset = _float_seq(offset, beams)
+    return _ENCAPSULATION + _float_seq(offset, 0)
 
 
 class Message:
@@ -96,10 +113,7 @@ class Odometry(Message):
 
     def size_bytes(self) -> int:
         """Header, child frame, PoseWithCovariance (7+36 doubles), TwistWithCovariance (6+36)."""
-        offset = _header(0, self.frame_id)
-        offset = _string(offset, self.child_frame_id)
-        offset = _doubles(offset, 7 + 36)
-        return _ENCAPSULATION + _doubles(offset, 6 + 36)
+        return _odometry_size(self.frame_id, self.child_frame_id)
 
 
 @dataclass(frozen=True, slots=True)
@@ -160,10 +174,7 @@ class LaserScan(Message):
 
     def size_bytes(self) -> int:
         """Header, 7 float32 fields, ranges and an empty intensities sequence."""
-        offset = _header(0, self.frame_id)
-        offset = _align(offset, 4) + 7 * 4
-        offset = _float_seq(offset, len(self.ranges_m))
-        return _ENCAPSULATION + _float_seq(offset, 0)
+        return _scan_size(self.frame_id, len(self.ranges_m))
 
 
 @dataclass(frozen=True, slots=True)

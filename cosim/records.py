@@ -9,7 +9,6 @@ exported both as exact ``*_ns`` columns and as ``*_s`` seconds columns.
 from __future__ import annotations
 
 import math
-from array import array
 from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
@@ -37,10 +36,8 @@ class _Interner:
             self.values.append(value)
         return code
 
-    def categorical(self, codes: array[int]) -> pd.Categorical[str]:
-        return pd.Categorical.from_codes(
-            np.frombuffer(codes, dtype=np.int32), categories=pd.Index(self.values)
-        )
+    def categorical(self, codes: npt.NDArray[np.int32]) -> pd.Categorical[str]:
+        return pd.Categorical.from_codes(codes, categories=pd.Index(self.values))
 
 
 class Table:
@@ -113,8 +110,14 @@ MESSAGE_COLUMNS = (
 EVENT_COLUMNS = ("t_s", "source", "kind", "detail", "t_ns")
 
 
+_FLUSH_ROWS = 65_536
+
+
 class Recorder:
     """Collects the run's tables: messages (from the bus tap), events, and adapter tables.
+
+    Message rows are appended as tuples (cheap on the hot path) and packed into NumPy
+    columns every 65,536 rows (bounded memory).
 
     Args:
         record_messages: keep a row per message and destination host.
@@ -125,13 +128,8 @@ class Recorder:
         self._hosts = _Interner()
         self._topics = _Interner()
         self._statuses = _Interner()
-        self._t_sent = array("q")
-        self._t_recv = array("q")
-        self._src = array("i")
-        self._dst = array("i")
-        self._topic = array("i")
-        self._bytes = array("q")
-        self._status = array("i")
+        self._pending: list[tuple[int, int, str, str, str, int, str]] = []
+        self._chunks: list[dict[str, npt.NDArray[Any]]] = []
         self._events = Table(("t_ns", "source", "kind", "detail"))
         self.tables: dict[str, Table] = {}
         self.counts: dict[str, int] = {status.value: 0 for status in DeliveryStatus}
@@ -148,16 +146,33 @@ class Recorder:
         status: DeliveryStatus,
     ) -> None:
         """Record one message towards one destination host (see :class:`cosim.bus.BusTap`)."""
-        self.counts[status.value] += 1
+        self.counts[status] += 1
         if not self.record_messages:
             return
-        self._t_sent.append(t_sent_ns)
-        self._t_recv.append(-1 if t_recv_ns is None else t_recv_ns)
-        self._src.append(self._hosts.code(src))
-        self._dst.append(self._hosts.code(dst))
-        self._topic.append(self._topics.code(topic))
-        self._bytes.append(nbytes)
-        self._status.append(self._statuses.code(status.value))
+        pending = self._pending
+        pending.append(
+            (t_sent_ns, -1 if t_recv_ns is None else t_recv_ns, src, dst, topic, nbytes, status)
+        )
+        if len(pending) >= _FLUSH_ROWS:
+            self._flush()
+
+    def _flush(self) -> None:
+        if not self._pending:
+            return
+        t_sent, t_recv, src, dst, topic, nbytes, status = zip(*self._pending, strict=True)
+        hosts, topics, statuses = self._hosts, self._topics, self._statuses
+        self._chunks.append(
+            {
+                "t_sent": np.array(t_sent, dtype=np.int64),
+                "t_recv": np.array(t_recv, dtype=np.int64),
+                "src": np.array([hosts.code(h) for h in src], dtype=np.int32),
+                "dst": np.array([hosts.code(h) for h in dst], dtype=np.int32),
+                "topic": np.array([topics.code(t) for t in topic], dtype=np.int32),
+                "bytes": np.array(nbytes, dtype=np.int64),
+                "status": np.array([statuses.code(str(v)) for v in status], dtype=np.int32),
+            }
+        )
+        self._pending = []
 
     # -- events and adapter tables ---------------------------------------------------
     def event(self, t_ns: int, source: str, kind: str, detail: str = "") -> None:
@@ -175,19 +190,25 @@ class Recorder:
     # -- export ----------------------------------------------------------------------
     def messages_frame(self) -> pd.DataFrame:
         """The messages table: one row per message and destination host."""
-        t_sent = np.frombuffer(self._t_sent, dtype=np.int64)
-        t_recv = np.frombuffer(self._t_recv, dtype=np.int64)
+        self._flush()
+
+        def column(name: str, dtype: type) -> npt.NDArray[Any]:
+            parts = [chunk[name] for chunk in self._chunks]
+            return np.concatenate(parts) if parts else np.zeros(0, dtype=dtype)
+
+        t_sent = column("t_sent", np.int64)
+        t_recv = column("t_recv", np.int64)
         received = t_recv >= 0
         t_recv_s = np.where(received, t_recv / NS_PER_S, math.nan)
         return pd.DataFrame(
             {
                 "t_sent_s": t_sent / NS_PER_S,
                 "t_recv_s": t_recv_s,
-                "src_host": self._hosts.categorical(self._src),
-                "dst_host": self._hosts.categorical(self._dst),
-                "topic": self._topics.categorical(self._topic),
-                "bytes": np.frombuffer(self._bytes, dtype=np.int64),
-                "status": self._statuses.categorical(self._status),
+                "src_host": self._hosts.categorical(column("src", np.int32)),
+                "dst_host": self._hosts.categorical(column("dst", np.int32)),
+                "topic": self._topics.categorical(column("topic", np.int32)),
+                "bytes": column("bytes", np.int64),
+                "status": self._statuses.categorical(column("status", np.int32)),
                 "t_sent_ns": t_sent,
                 "t_recv_ns": pd.arrays.IntegerArray(np.where(received, t_recv, 0), ~received),
             },

@@ -4,7 +4,8 @@ State per robot: pose ``x, y, yaw`` in ``map`` and body velocities ``v`` (m/s, f
 and ``w`` (rad/s, counter-clockwise). Commands are body velocities. Per step, the
 commanded velocities are first limited in magnitude and slewed by the acceleration
 limits, then held constant over the step, for which the unicycle has an exact closed
-form solution (arcs of a circle; straight lines when ``w`` is 0).
+form solution (arcs of a circle; straight lines when ``w`` is 0), evaluated through the
+chord of the arc so that it stays exact as ``w`` approaches 0.
 """
 
 from __future__ import annotations
@@ -15,9 +16,6 @@ import numpy as np
 import numpy.typing as npt
 
 FloatArray = npt.NDArray[np.float64]
-
-_STRAIGHT_EPS = 1e-9
-"""|w * dt| below which the arc is integrated as a straight line (rad)."""
 
 
 @dataclass(frozen=True)
@@ -81,18 +79,13 @@ def integrate(
         The new poses; yaw wrapped to [-pi, pi).
     """
     dtheta = w * dt_s
-    new_yaw = yaw + dtheta
-    turning = np.abs(dtheta) > _STRAIGHT_EPS
-    safe_w = np.where(turning, w, 1.0)
-    arc_x = (np.sin(new_yaw) - np.sin(yaw)) * v / safe_w
-    arc_y = (np.cos(yaw) - np.cos(new_yaw)) * v / safe_w
-    # below the threshold, the chord along the mid heading differs from the arc by
-    # v*dt*(w*dt)^2/24, i.e. less than 1e-18 m for any speed a robot can reach
+    # the arc's chord has length v*dt*sinc(dtheta/2) along the mid heading; written with
+    # numpy's sinc it is exact for every w, with no cancellation as w approaches 0
+    chord = v * dt_s * np.sinc(dtheta / (2 * np.pi))
     mid = yaw + 0.5 * dtheta
-    line_x = v * dt_s * np.cos(mid)
-    line_y = v * dt_s * np.sin(mid)
-    new_x = x + np.where(turning, arc_x, line_x)
-    new_y = y + np.where(turning, arc_y, line_y)
+    new_x = x + chord * np.cos(mid)
+    new_y = y + chord * np.sin(mid)
+    new_yaw = yaw + dtheta
     return new_x, new_y, wrap_angle(new_yaw)
 
 
@@ -106,7 +99,7 @@ class FleetState:
         v_cmd, w_cmd: latest commanded body velocities.
         radius_m: footprint radius (m) per robot.
         stopped: robots held still (e.g. in contact) until released.
-        distance_m: distance driven so far per robot (m).
+        distance_m: distance driven so far per robot (m, chord length per step).
     """
 
     def __init__(self, names: list[str], starts: FloatArray, radius_m: float) -> None:
@@ -133,11 +126,44 @@ class FleetState:
         """(n, 2) positions in ``map`` (m)."""
         return np.stack([self.x, self.y], axis=1)
 
-    def step(self, limits: DriveLimits, dt_s: float) -> None:
-        """Advance every robot by ``dt_s`` under its latest command (one vectorized update)."""
+    def propose(self, limits: DriveLimits, dt_s: float) -> Motion:
+        """The motion every robot would make over ``dt_s`` under its latest command."""
         v, w = limit_commands(self.v, self.w, self.v_cmd, self.w_cmd, limits, dt_s)
         v = np.where(self.stopped, 0.0, v)
         w = np.where(self.stopped, 0.0, w)
-        self.x, self.y, self.yaw = integrate(self.x, self.y, self.yaw, v, w, dt_s)
-        self.v, self.w = v, w
-        self.distance_m += np.abs(v) * dt_s
+        x, y, yaw = integrate(self.x, self.y, self.yaw, v, w, dt_s)
+        return Motion(x, y, yaw, v, w)
+
+    def hold(self, motion: Motion, robots: npt.NDArray[np.int64]) -> None:
+        """Keep ``robots`` where they are in ``motion``, at standstill."""
+        motion.x[robots] = self.x[robots]
+        motion.y[robots] = self.y[robots]
+        motion.yaw[robots] = self.yaw[robots]
+        motion.v[robots] = 0.0
+        motion.w[robots] = 0.0
+
+    def commit(self, motion: Motion) -> None:
+        """Make ``motion`` the new state."""
+        self.distance_m += np.hypot(motion.x - self.x, motion.y - self.y)
+        self.x, self.y, self.yaw = motion.x, motion.y, motion.yaw
+        self.v, self.w = motion.v, motion.w
+
+    def step(self, limits: DriveLimits, dt_s: float) -> None:
+        """Advance every robot by ``dt_s`` under its latest command (one vectorized update)."""
+        self.commit(self.propose(limits, dt_s))
+
+
+@dataclass
+class Motion:
+    """A proposed state of the fleet after one step (arrays indexed by robot).
+
+    Attributes:
+        x, y, yaw: poses in ``map`` (m, m, rad).
+        v, w: velocities held over the step (m/s, rad/s).
+    """
+
+    x: FloatArray
+    y: FloatArray
+    yaw: FloatArray
+    v: FloatArray
+    w: FloatArray

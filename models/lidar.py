@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -62,9 +63,33 @@ class ScanGeometry:
         )
 
 
+def beam_directions(yaws: FloatArray, beam_angles: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Unit directions in ``map`` of every beam of every sensor.
+
+    The beam's sensor-frame direction ``(cos a, sin a)`` rotated by the sensor's yaw:
+    ``dx = cos(yaw) cos(a) - sin(yaw) sin(a)``, ``dy = sin(yaw) cos(a) + cos(yaw) sin(a)``.
+    This is *the* definition of a beam's direction: every caster evaluates exactly these
+    products and sums, so all of them agree bit for bit on which beams graze a corner,
+    and only ``r + b`` trigonometric calls are needed instead of ``r * b``.
+
+    Args:
+        yaws: (r,) sensor headings in ``map`` (rad).
+        beam_angles: (b,) beam angles in the sensor frame (rad).
+
+    Returns:
+        ``(dx, dy)``, each (r, b).
+    """
+    cy = np.cos(yaws)[:, None]
+    sy = np.sin(yaws)[:, None]
+    ca = np.cos(beam_angles)[None, :]
+    sa = np.sin(beam_angles)[None, :]
+    return cy * ca - sy * sa, sy * ca + cy * sa
+
+
 def cast_reference(
     origins: FloatArray,
-    angles: FloatArray,
+    yaws: FloatArray,
+    beam_angles: FloatArray,
     segments: FloatArray,
     circles: FloatArray,
     range_max_m: float,
@@ -74,7 +99,9 @@ def cast_reference(
 
     Args:
         origins: (r, 2) ray origins in ``map`` (m).
-        angles: (r, b) absolute beam angles in ``map`` (rad).
+        yaws: (r,) sensor headings in ``map`` (rad).
+        beam_angles: (b,) beam angles in the sensor frame (rad); directions as
+            :func:`beam_directions`.
         segments: (s, 4) segments ``x0, y0, x1, y1`` (m).
         circles: (c, 3) circles ``x, y, radius`` (m), e.g. other robots.
         range_max_m: rays longer than this read ``inf``.
@@ -85,9 +112,12 @@ def cast_reference(
     """
     ox = origins[:, 0, None, None]
     oy = origins[:, 1, None, None]
-    dx = np.cos(angles)[:, :, None]
-    dy = np.sin(angles)[:, :, None]
-    best = np.full(angles.shape, np.inf)
+    dir_x, dir_y = beam_directions(
+        np.asarray(yaws, dtype=float), np.asarray(beam_angles, dtype=float)
+    )
+    dx = dir_x[:, :, None]
+    dy = dir_y[:, :, None]
+    best = np.full(dir_x.shape, np.inf)
     if len(segments):
         x0, y0, x1, y1 = (segments[:, k][None, None, :] for k in range(4))
         ex, ey = x1 - x0, y1 - y0
@@ -124,22 +154,27 @@ def apply_sensor_model(
     geometry: ScanGeometry,
     noise_std_m: float,
     dropout_prob: float,
-    rng: np.random.Generator,
+    normals: npt.NDArray[np.floating[Any]],
+    uniforms: npt.NDArray[np.floating[Any]],
 ) -> npt.NDArray[np.float32]:
-    """Add Gaussian range noise and dropouts to exact ranges of one scan.
+    """Add Gaussian range noise and dropouts to exact ranges (any shape, e.g. robots x beams).
 
-    The noise is drawn for every beam (hit or not) so the stream's position does not
-    depend on the scene. Noisy hits beyond ``range_max`` read ``inf``, below
-    ``range_min`` read ``-inf`` (REP 117).
+    Noisy hits beyond ``range_max`` read ``inf``, below ``range_min`` read ``-inf``
+    (REP 117); dropped beams read ``nan``.
+
+    Args:
+        ranges: exact ranges (m); ``inf`` where nothing was hit.
+        geometry: the lidar's limits.
+        noise_std_m: standard deviation of the range noise (m).
+        dropout_prob: probability that a beam returns nothing.
+        normals: standard normal draws, same shape as ``ranges`` (any float dtype).
+        uniforms: uniform draws in [0, 1), same shape as ``ranges`` (any float dtype).
 
     Returns:
         float32 ranges as published in a LaserScan.
     """
-    noise = rng.standard_normal(ranges.shape) * noise_std_m
-    drop = rng.random(ranges.shape) < dropout_prob
-    noisy = ranges + noise
-    out = np.where(np.isfinite(ranges), noisy, np.inf)
+    out = np.where(np.isfinite(ranges), ranges + normals * noise_std_m, np.inf)
     out = np.where(out > geometry.range_max_m, np.inf, out)
     out = np.where(out < geometry.range_min_m, -np.inf, out)
-    out = np.where(drop, np.nan, out)
+    out = np.where(uniforms < dropout_prob, np.nan, out)
     return out.astype(np.float32)

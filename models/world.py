@@ -1,5 +1,7 @@
 """The warehouse world: walls, shelves and robot start poses (frame ``map``).
 
+``WarehouseSpec`` and the shelf layouts live in :mod:`models.layout`.
+
 The inner room spans ``[0, size_x] x [0, size_y]`` metres; the walls lie outside it. All
 obstacles are axis-aligned boxes ``(xmin, ymin, xmax, ymax)``: shelves turned by 90 deg
 simply swap their extents. Every layout keeps a gap of at least ``aisle_width_m``
@@ -12,36 +14,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Literal
 
 import numpy as np
 import numpy.typing as npt
 
 from models.errors import ModelError
+from models.layout import (
+    DOCK_GAP_M,
+    START_CLEARANCE_M,
+    WarehouseSpec,
+    place_shelves,
+)
 
 FloatArray = npt.NDArray[np.float64]
-
-DOCK_GAP_M = 0.3
-"""Free gap between neighbouring robots in the dock (m)."""
-START_CLEARANCE_M = 0.1
-"""Clearance kept between a start pose and any obstacle or robot (m)."""
-
-
-@dataclass(frozen=True)
-class WarehouseSpec:
-    """Parameters of a warehouse (mirrors the ``world`` and ``robots`` scenario sections)."""
-
-    size_m: tuple[float, float] = (30.0, 30.0)
-    layout: Literal["random", "all_rows", "two_corridors"] = "random"
-    shelf_size_m: tuple[float, float] = (2.0, 0.8)
-    shelf_count: int = 24
-    shelves_per_rack: int = 3
-    aisle_width_m: float = 1.6
-    wall_thickness_m: float = 0.2
-    robot_count: int = 4
-    robot_radius_m: float = 0.33
-    placement: Literal["dock", "random", "explicit"] = "dock"
-    positions: tuple[tuple[float, float, float], ...] = field(default=())
 
 
 @dataclass(frozen=True)
@@ -55,6 +40,7 @@ class Warehouse:
         shelves: (n, 4) shelf boxes in ``map`` (m).
         starts: (robots, 3) start poses ``x_m, y_m, yaw_rad`` in ``map``.
         dock_depth_m: depth of the dock strip along the south wall (m).
+        obstacles: (k, 4) extra obstacle boxes given by the user, in ``map`` (m).
     """
 
     size_m: tuple[float, float]
@@ -63,11 +49,17 @@ class Warehouse:
     shelves: FloatArray
     starts: FloatArray
     dock_depth_m: float
+    obstacles: FloatArray = field(default_factory=lambda: np.zeros((0, 4)))
 
     @property
     def boxes(self) -> FloatArray:
-        """All static obstacles (walls, then shelves) as an (n, 4) box array."""
-        return np.vstack([self.walls, self.shelves])
+        """All static obstacles (walls, shelves, then extra obstacles) as an (n, 4) array."""
+        return np.vstack([self.walls, self.shelves, self.obstacles])
+
+    @property
+    def inner_boxes(self) -> FloatArray:
+        """Shelves and extra obstacles (everything inside the room) as an (n, 4) array."""
+        return np.vstack([self.shelves, self.obstacles])
 
     @property
     def bounds(self) -> tuple[float, float, float, float]:
@@ -93,9 +85,10 @@ class Warehouse:
             & (pts[:, 0] <= self.size_m[0] - radius_m)
             & (pts[:, 1] <= self.size_m[1] - radius_m)
         )
-        if len(self.shelves) == 0:
+        inner = self.inner_boxes
+        if len(inner) == 0:
             return inside
-        clear: npt.NDArray[np.bool_] = box_distance(pts, self.shelves).min(axis=1) >= radius_m
+        clear: npt.NDArray[np.bool_] = box_distance(pts, inner).min(axis=1) >= radius_m
         return inside & clear
 
 
@@ -149,121 +142,6 @@ def dock_depth(spec: WarehouseSpec) -> float:
         return 0.0
     _, rows = dock_rows(spec)
     return rows * (2 * spec.robot_radius_m + DOCK_GAP_M) + DOCK_GAP_M
-
-
-def _shelf_region(spec: WarehouseSpec, dock: float) -> tuple[float, float, float, float]:
-    aisle = spec.aisle_width_m
-    width, height = spec.size_m
-    return (aisle, dock + aisle, width - aisle, height - aisle)
-
-
-def _rack_shelves(
-    spec: WarehouseSpec, region: tuple[float, float, float, float], bands: list[tuple[float, float]]
-) -> FloatArray:
-    """Shelves in racks of ``shelves_per_rack`` along x, rows of racks along y, per x band."""
-    length, depth = spec.shelf_size_m
-    aisle = spec.aisle_width_m
-    k = spec.shelves_per_rack
-    rack = k * length
-    _, ymin, _, ymax = region
-    rows = int((ymax - ymin + aisle) // (depth + aisle))
-    slots: list[list[float]] = []
-    for bx0, bx1 in bands:
-        cols = int((bx1 - bx0 + aisle) // (rack + aisle))
-        if cols < 1 or rows < 1:
-            continue
-        used_x = cols * rack + (cols - 1) * aisle
-        used_y = rows * depth + (rows - 1) * aisle
-        x_start = bx0 + (bx1 - bx0 - used_x) / 2
-        y_start = ymin + (ymax - ymin - used_y) / 2
-        for row in range(rows - 1, -1, -1):  # fill from the north, far from the dock
-            y0 = y_start + row * (depth + aisle)
-            for col in range(cols):
-                for i in range(k):
-                    x0 = x_start + col * (rack + aisle) + i * length
-                    slots.append([x0, y0, x0 + length, y0 + depth])
-    return np.array(slots, dtype=float).reshape(-1, 4)
-
-
-def _random_shelves(
-    spec: WarehouseSpec, region: tuple[float, float, float, float], rng: np.random.Generator
-) -> FloatArray:
-    length, depth = spec.shelf_size_m
-    xmin, ymin, xmax, ymax = region
-    aisle = spec.aisle_width_m
-    # each shelf with half an aisle around it claims (L + a) x (D + a) of the region grown
-    # by half an aisle on every side: more than fits there is impossible
-    capacity = int(
-        (xmax - xmin + aisle) * (ymax - ymin + aisle) // ((length + aisle) * (depth + aisle))
-    )
-    if spec.shelf_count > capacity:
-        raise ModelError(
-            "world.shelf_count",
-            spec.shelf_count,
-            f"at most {capacity} shelves of {list(spec.shelf_size_m)} m with {aisle:g} m aisles "
-            f"in a {list(spec.size_m)} m room (by area)",
-        )
-    placed: list[list[float]] = []
-    attempts = 0
-    limit = 50_000
-    while len(placed) < spec.shelf_count and attempts < limit:
-        attempts += 1
-        sx, sy = (length, depth) if rng.random() < 0.5 else (depth, length)
-        if sx > xmax - xmin or sy > ymax - ymin:
-            continue
-        x0 = rng.uniform(xmin, xmax - sx)
-        y0 = rng.uniform(ymin, ymax - sy)
-        box = [x0, y0, x0 + sx, y0 + sy]
-        if placed:
-            others = np.array(placed)
-            gap_x = np.maximum(others[:, 0] - box[2], box[0] - others[:, 2])
-            gap_y = np.maximum(others[:, 1] - box[3], box[1] - others[:, 3])
-            # the gap between two boxes is the larger of the axis gaps when one is
-            # negative; both positive means a diagonal gap of hypot(gap_x, gap_y)
-            gap = np.where(
-                (gap_x > 0) & (gap_y > 0), np.hypot(gap_x, gap_y), np.maximum(gap_x, gap_y)
-            )
-            if np.any(gap < aisle):
-                continue
-        placed.append(box)
-    if len(placed) < spec.shelf_count:
-        raise ModelError(
-            "world.shelf_count",
-            spec.shelf_count,
-            f"at most about {len(placed)} shelves of {list(spec.shelf_size_m)} m with "
-            f"{aisle:g} m aisles in a {list(spec.size_m)} m room",
-        )
-    return np.array(placed, dtype=float).reshape(-1, 4)
-
-
-def _shelves(spec: WarehouseSpec, dock: float, rng: np.random.Generator) -> FloatArray:
-    region = _shelf_region(spec, dock)
-    if spec.shelf_count == 0:
-        return np.zeros((0, 4))
-    if region[2] <= region[0] or region[3] <= region[1]:
-        raise ModelError(
-            "world.size_m", list(spec.size_m), "a room large enough for aisles around the dock"
-        )
-    if spec.layout == "random":
-        return _random_shelves(spec, region, rng)
-    xmin, _, xmax, _ = region
-    if spec.layout == "all_rows":
-        bands = [(xmin, xmax)]
-    else:  # two_corridors: two north-south main corridors, two aisles wide
-        corridor = 2 * spec.aisle_width_m
-        third = (xmax - xmin - 2 * corridor) / 3
-        bands = [
-            (xmin + i * (third + corridor), xmin + i * (third + corridor) + third) for i in range(3)
-        ]
-    slots = _rack_shelves(spec, region, bands)
-    if spec.shelf_count > len(slots):
-        raise ModelError(
-            "world.shelf_count",
-            spec.shelf_count,
-            f"at most {len(slots)} shelves for layout {spec.layout!r} in a "
-            f"{list(spec.size_m)} m room with {spec.aisle_width_m:g} m aisles",
-        )
-    return slots[: spec.shelf_count]
 
 
 def _dock_starts(spec: WarehouseSpec) -> FloatArray:
@@ -322,6 +200,20 @@ def _check_explicit(spec: WarehouseSpec, world: Warehouse) -> FloatArray:
     return starts
 
 
+def _check_obstacles(spec: WarehouseSpec) -> FloatArray:
+    boxes = np.array(spec.obstacles, dtype=float).reshape(-1, 4)
+    width, height = spec.size_m
+    for i, (xmin, ymin, xmax, ymax) in enumerate(boxes):
+        if not (0 <= xmin < xmax <= width and 0 <= ymin < ymax <= height):
+            raise ModelError(
+                f"world.obstacles[{i}]",
+                list(spec.obstacles[i]),
+                f"a box [xmin, ymin, xmax, ymax] with xmin < xmax, ymin < ymax inside the "
+                f"room [0, 0, {width:g}, {height:g}]",
+            )
+    return boxes
+
+
 def generate_warehouse(spec: WarehouseSpec, rng: np.random.Generator) -> Warehouse:
     """Generate a warehouse from its parameters.
 
@@ -347,7 +239,8 @@ def generate_warehouse(spec: WarehouseSpec, rng: np.random.Generator) -> Warehou
             spec.robot_count,
             f"a fleet whose dock fits in half the room ({height / 2:g} m)",
         )
-    shelves = _shelves(spec, dock, rng)
+    obstacles = _check_obstacles(spec)
+    shelves = place_shelves(spec, dock, rng)
     world = Warehouse(
         size_m=(width, height),
         wall_thickness_m=spec.wall_thickness_m,
@@ -355,9 +248,18 @@ def generate_warehouse(spec: WarehouseSpec, rng: np.random.Generator) -> Warehou
         shelves=shelves,
         starts=np.zeros((0, 3)),
         dock_depth_m=dock,
+        obstacles=obstacles,
     )
     if spec.placement == "dock":
         starts = _dock_starts(spec)
+        blocked = ~world.is_free(starts[:, :2], spec.robot_radius_m)
+        if blocked.any():
+            raise ModelError(
+                "world.obstacles",
+                [list(o) for o in spec.obstacles],
+                f"boxes clear of the dock strip (y < {dock:g} m), where robot "
+                f"{int(np.flatnonzero(blocked)[0])} starts",
+            )
     elif spec.placement == "random":
         starts = _random_starts(spec, world, rng)
     else:
@@ -369,4 +271,5 @@ def generate_warehouse(spec: WarehouseSpec, rng: np.random.Generator) -> Warehou
         shelves=world.shelves,
         starts=starts,
         dock_depth_m=dock,
+        obstacles=obstacles,
     )

@@ -7,6 +7,7 @@ from typing import Any, get_type_hints
 
 from cosim.scenario.sections import (
     LidarConfig,
+    OdometryConfig,
     RecordConfig,
     RobotsConfig,
     ScenarioSection,
@@ -26,6 +27,7 @@ class Scenario:
     world: WorldConfig = field(default_factory=WorldConfig)
     robots: RobotsConfig = field(default_factory=RobotsConfig)
     lidar: LidarConfig = field(default_factory=LidarConfig)
+    odometry: OdometryConfig = field(default_factory=OdometryConfig)
     record: RecordConfig = field(default_factory=RecordConfig)
     source: str = field(default="<defaults>", compare=False)
 

@@ -45,6 +45,9 @@ class WorldConfig:
     shelves_per_rack: int = param(3, "rows layouts: shelves end to end in one rack", ge=1)
     aisle_width_m: float = param(1.6, "minimum free gap between shelves and walls (m)", gt=0)
     wall_thickness_m: float = param(0.2, "thickness of the outer walls (m)", gt=0)
+    obstacles: tuple[tuple[float, float, float, float], ...] = param(
+        (), "extra obstacle boxes [[xmin_m, ymin_m, xmax_m, ymax_m], ...] in map"
+    )
 
     def problems(self) -> Iterator[Problem]:
         """Shelves must be smaller than the room."""
@@ -75,6 +78,10 @@ class RobotsConfig:
     max_yaw_accel_radps2: float = param(3.0, "yaw acceleration limit (rad/s^2)", gt=0)
     radius_m: float = param(0.33, "footprint radius (m)", gt=0)
     control_hz: float = param(20.0, "kinematics and odometry rate (Hz)", gt=0, le=1000)
+    driver: Literal["waypoints", "wander"] = param(
+        "waypoints",
+        "robot behaviour: straight-line random waypoints, or reactive lidar wandering",
+    )
 
     def problems(self) -> Iterator[Problem]:
         """Explicit placement needs one pose per robot."""
@@ -112,6 +119,19 @@ class LidarConfig:
             yield Problem(
                 "range_min_m", self.range_min_m, f"a value < range_max_m ({self.range_max_m:g})"
             )
+
+
+@dataclass(frozen=True)
+class OdometryConfig:
+    """``[odometry]``: wheel odometry of every robot."""
+
+    drift: float = param(
+        0.0,
+        "noise scale: 1 m driven straight gives `drift` m distance and `drift` rad heading "
+        "error (1 sigma); 0 = perfect",
+        ge=0,
+        le=1,
+    )
 
 
 @dataclass(frozen=True)

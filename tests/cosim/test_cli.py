@@ -150,6 +150,10 @@ def test_invalid_scenario_files_exit_2_with_one_line_naming_the_key(tmp_path, co
         (["run", "warehouse-random", "--seed", "-1"], "expected an integer >= 0"),
         (["run", "warehouse-random", "--duration-s", "0"], "not a finite number > 0"),
         (["run", "warehouse-random", "--set", "world.shelf_count=400"], "world.shelf_count = 400"),
+        (
+            ["check", "warehouse-random", "--set", "world.shelf_count=400"],
+            "world.shelf_count = 400",
+        ),
         (["frobnicate"], "invalid choice"),
     ],
 )
@@ -186,3 +190,45 @@ def test_help_explains_every_command():
     run_help = cosim_cli("run", "--help").stdout
     for flag in ("--out", "--seed", "--duration-s", "--set", "--quiet", "--force"):
         assert flag in run_help
+
+
+def test_world_writes_a_picture_a_map_and_an_sdf_world(tmp_path):
+    done = cosim_cli(
+        "world",
+        "warehouse-rows",
+        "--png",
+        str(tmp_path / "w.png"),
+        "--map",
+        str(tmp_path / "w.yaml"),
+        "--sdf",
+        str(tmp_path / "w.sdf"),
+    )
+    assert done.returncode == 0, done.stderr
+    for name in ("w.png", "w.yaml", "w.pgm", "w.sdf"):
+        assert (tmp_path / name).stat().st_size > 0
+    assert f"wrote {tmp_path / 'w.sdf'}" in done.stdout
+
+
+def test_world_without_outputs_describes_the_world(capsys):
+    assert main(["world", "fleet50"]) == 0
+    out = capsys.readouterr().out
+    assert "fleet50" in out and "72 shelves" in out and "50 robots" in out
+
+
+def test_wander_without_a_lidar_is_refused_naming_the_keys(tmp_path):
+    done = cosim_cli(
+        "check", "warehouse-random", "--set", "robots.driver=wander", "--set", "lidar.beams=0"
+    )
+    assert done.returncode == 2
+    done = cosim_cli(
+        "run",
+        "warehouse-random",
+        "--set",
+        "robots.driver=wander",
+        "--set",
+        "lidar.beams=0",
+        "--out",
+        str(tmp_path / "o"),
+    )
+    assert done.returncode == 2
+    assert "driver = 'wander': expected lidar.beams > 0" in done.stderr

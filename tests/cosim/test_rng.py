@@ -43,3 +43,15 @@ def test_the_global_numpy_state_is_untouched():
     np.random.seed(123)
     RngStreams(1).stream("x").random(10)
     np.testing.assert_array_equal(np.random.random(3), expected)
+
+
+def test_block_draws_give_each_component_exactly_its_own_stream():
+    from cosim.rng import BlockDraws
+
+    blocks = BlockDraws([RngStreams(2).stream(f"c{i}") for i in range(3)], width=4, budget=24)
+    assert blocks.block == 2
+    drawn = np.stack([blocks.draw().copy() for _ in range(5)], axis=1)  # (3, 5, 4)
+    for i in range(3):
+        alone = RngStreams(2).stream(f"c{i}")
+        expected = np.concatenate([alone.standard_normal((2, 4)) for _ in range(3)])[:5]
+        np.testing.assert_array_equal(drawn[i], expected)

@@ -3,7 +3,7 @@ import math
 import numpy as np
 import pytest
 
-from models.lidar import ScanGeometry, apply_sensor_model, cast_reference
+from models.lidar import ScanGeometry, apply_sensor_model, beam_directions, cast_reference
 from models.world import box_segments
 
 
@@ -25,8 +25,8 @@ def test_a_narrow_scan_spans_the_field_of_view_end_to_end():
 def test_rays_hit_an_axis_aligned_box_at_the_analytic_distance():
     segments = box_segments(np.array([[2.0, -1.0, 3.0, 1.0]]))
     origins = np.array([[0.0, 0.0]])
-    angles = np.array([[0.0, math.atan2(0.5, 2.0), math.pi]])
-    ranges = cast_reference(origins, angles, segments, np.zeros((0, 3)), 10.0)
+    beams = np.array([0.0, math.atan2(0.5, 2.0), math.pi])
+    ranges = cast_reference(origins, np.array([0.0]), beams, segments, np.zeros((0, 3)), 10.0)
     assert ranges[0, 0] == pytest.approx(2.0)
     assert ranges[0, 1] == pytest.approx(math.hypot(2.0, 0.5))
     assert ranges[0, 2] == math.inf
@@ -35,9 +35,14 @@ def test_rays_hit_an_axis_aligned_box_at_the_analytic_distance():
 def test_rays_hit_circles_and_ignore_the_robots_own_body():
     circles = np.array([[0.0, 0.0, 0.3], [4.0, 0.0, 0.5]])
     origins = np.array([[0.0, 0.0], [4.0, 0.0]])
-    angles = np.array([[0.0, math.pi], [math.pi, 0.0]])
     ranges = cast_reference(
-        origins, angles, np.zeros((0, 4)), circles, 10.0, exclude=np.array([0, 1])
+        origins,
+        np.array([0.0, math.pi]),
+        np.array([0.0, math.pi]),
+        np.zeros((0, 4)),
+        circles,
+        10.0,
+        exclude=np.array([0, 1]),
     )
     assert ranges[0, 0] == pytest.approx(3.5)
     assert ranges[0, 1] == math.inf
@@ -47,27 +52,50 @@ def test_rays_hit_circles_and_ignore_the_robots_own_body():
 def test_hits_beyond_the_maximum_range_read_infinity():
     segments = box_segments(np.array([[5.0, -1.0, 6.0, 1.0]]))
     ranges = cast_reference(
-        np.array([[0.0, 0.0]]), np.array([[0.0]]), segments, np.zeros((0, 3)), 4.0
+        np.array([[0.0, 0.0]]), np.array([0.0]), np.array([0.0]), segments, np.zeros((0, 3)), 4.0
     )
     assert ranges[0, 0] == math.inf
 
 
-def test_the_sensor_model_follows_rep_117_and_is_seeded():
+def _draws(shape, seed):
+    rng = np.random.default_rng(seed)
+    return rng.standard_normal(shape), rng.random(shape)
+
+
+def test_the_sensor_model_follows_rep_117():
     geometry = ScanGeometry(4, 2 * math.pi, 0.5, 10.0)
     exact = np.array([0.2, 3.0, math.inf, 9.9999])
-    out = apply_sensor_model(exact, geometry, 0.0, 0.0, np.random.default_rng(1))
+    out = apply_sensor_model(exact, geometry, 0.0, 0.0, *_draws(4, 1))
     assert out.dtype == np.float32
     assert out[0] == -math.inf and out[1] == 3.0 and out[2] == math.inf
-    dropped = apply_sensor_model(exact, geometry, 0.0, 1.0, np.random.default_rng(1))
+    dropped = apply_sensor_model(exact, geometry, 0.0, 1.0, *_draws(4, 1))
     assert np.all(np.isnan(dropped))
-    a = apply_sensor_model(exact, geometry, 0.05, 0.1, np.random.default_rng(7))
-    b = apply_sensor_model(exact, geometry, 0.05, 0.1, np.random.default_rng(7))
-    np.testing.assert_array_equal(a, b)
 
 
-def test_range_noise_has_the_configured_standard_deviation():
+def test_the_sensor_model_works_on_a_whole_fleet_at_once():
+    geometry = ScanGeometry(360, 2 * math.pi, 0.1, 10.0)
+    exact = np.full((50, 360), 4.0)
+    normals, uniforms = _draws((50, 360), 2)
+    fleet = apply_sensor_model(exact, geometry, 0.05, 0.1, normals, uniforms)
+    one = apply_sensor_model(exact[7], geometry, 0.05, 0.1, normals[7], uniforms[7])
+    np.testing.assert_array_equal(fleet[7], one)
+
+
+def test_range_noise_has_the_configured_standard_deviation_and_dropout_its_rate():
     geometry = ScanGeometry(20000, 2 * math.pi, 0.1, 10.0)
     exact = np.full(20000, 5.0)
-    out = apply_sensor_model(exact, geometry, 0.02, 0.0, np.random.default_rng(3))
-    assert np.std(out - 5.0) == pytest.approx(0.02, rel=0.03)
-    assert abs(np.mean(out - 5.0)) < 0.001
+    out = apply_sensor_model(exact, geometry, 0.02, 0.1, *_draws(20000, 3))
+    hits = out[~np.isnan(out)]
+    assert np.std(hits - 5.0) == pytest.approx(0.02, rel=0.03)
+    assert abs(np.mean(hits - 5.0)) < 0.001
+    assert np.isnan(out).mean() == pytest.approx(0.1, abs=0.01)
+
+
+def test_beam_directions_are_unit_vectors_at_the_beam_angles():
+    yaws = np.array([0.3, -2.0])
+    beams = np.linspace(-math.pi, math.pi, 7)
+    dx, dy = beam_directions(yaws, beams)
+    np.testing.assert_allclose(np.hypot(dx, dy), 1.0, atol=1e-15)
+    np.testing.assert_allclose(
+        np.arctan2(dy, dx), np.angle(np.exp(1j * (yaws[:, None] + beams))), atol=1e-12
+    )

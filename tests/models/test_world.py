@@ -80,15 +80,45 @@ def test_too_many_shelves_in_rows_are_refused_with_the_capacity():
         _gen(layout="all_rows", shelf_count=1000)
 
 
-def test_a_robot_inside_a_shelf_is_refused():
-    world = _gen(shelf_count=3)
-    x0, y0, x1, y1 = world.shelves[0]
-    inside = ((x0 + x1) / 2, (y0 + y1) / 2, 0.0)
+def test_a_robot_inside_an_obstacle_is_refused():
     with pytest.raises(ModelError) as error:
         _gen(
-            shelf_count=3, placement="explicit", robot_count=2, positions=((5.0, 1.0, 0.0), inside)
+            shelf_count=0,
+            obstacles=((4.0, 4.0, 6.0, 6.0),),
+            placement="explicit",
+            robot_count=2,
+            positions=((1.0, 1.0, 0.0), (5.0, 5.0, 0.0)),
         )
     assert error.value.key == "robots.positions[1]"
+
+
+def test_shelves_are_generated_around_explicit_start_poses():
+    positions = tuple((x, y, 0.0) for x in (5.0, 15.0, 25.0) for y in (8.0, 16.0, 24.0))
+    for layout in ("random", "all_rows"):
+        world = _gen(
+            layout=layout, shelf_count=20, placement="explicit", robot_count=9, positions=positions
+        )
+        assert world.is_free(world.starts[:, :2], 0.33).all()
+
+
+def test_shelves_keep_an_aisle_from_extra_obstacles():
+    obstacle = (10.0, 10.0, 14.0, 14.0)
+    for layout in ("random", "all_rows", "two_corridors"):
+        world = _gen(layout=layout, shelf_count=20, obstacles=(obstacle,))
+        gaps = [box(*b).distance(box(*obstacle)) for b in world.shelves]
+        assert min(gaps) >= 1.6 - 1e-9
+        assert world.boxes.shape == (4 + 20 + 1, 4)
+
+
+def test_an_obstacle_outside_the_room_is_refused():
+    with pytest.raises(ModelError) as error:
+        _gen(obstacles=((28.0, 5.0, 31.0, 6.0),))
+    assert error.value.key == "world.obstacles[0]"
+
+
+def test_an_obstacle_on_the_dock_is_refused():
+    with pytest.raises(ModelError, match="clear of the dock strip"):
+        _gen(shelf_count=0, obstacles=((14.0, 0.0, 16.0, 1.0),))
 
 
 def test_overlapping_explicit_robots_are_refused():

@@ -1,0 +1,19 @@
+import pytest
+
+import cosim
+from cosim.scenario import preset_names
+
+
+@pytest.mark.parametrize("name", preset_names())
+def test_every_preset_runs_two_seconds_without_robots_overlapping(name):
+    result = cosim.run(cosim.load_scenario(name), duration_s=2.0)
+    assert result.summary["robots"] == cosim.load_scenario(name).robots.count
+    assert result.summary["min_clearance_m"] >= 0
+    assert len(result.tables["poses"]) == 20 * result.summary["robots"]
+
+
+def test_the_paper_presets_have_the_papers_fleets_and_rooms():
+    assert cosim.load_scenario("fleet50").robots.count == 50
+    assert cosim.load_scenario("fleet50").world.size_m == (30.0, 30.0)
+    assert cosim.load_scenario("warehouse-rows").world.layout == "all_rows"
+    assert cosim.load_scenario("lab-room").world.size_m == (4.0, 8.0)

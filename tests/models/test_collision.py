@@ -1,0 +1,83 @@
+import math
+
+import numpy as np
+import pytest
+from shapely.geometry import Point, box
+
+from models.collision import CollisionChecker, OtherKind, disc_box_clearance
+
+BOXES = np.array([[2.0, 2.0, 4.0, 3.0], [6.0, 0.0, 6.5, 8.0]])
+
+
+def _shapely_clearance(x, y, r, b):
+    disc = Point(x, y).buffer(r, quad_segs=256)
+    rect = box(*b)
+    if disc.intersects(rect):
+        return None
+    return disc.distance(rect)
+
+
+@pytest.mark.parametrize(("x", "y"), [(1.0, 1.0), (3.0, 1.5), (4.6, 2.5), (1.2, 3.8)])
+def test_disc_box_clearance_matches_shapely_outside(x, y):
+    expected = _shapely_clearance(x, y, 0.3, BOXES[0])
+    got = disc_box_clearance(np.array([x]), np.array([y]), np.array([0.3]), BOXES[:1])[0]
+    assert got == pytest.approx(expected, abs=1e-4)
+
+
+def test_disc_box_clearance_is_minus_the_depth_when_overlapping():
+    got = disc_box_clearance(
+        np.array([3.0, 3.0]), np.array([1.9, 2.1]), np.array([0.3, 0.3]), BOXES[[0, 0]]
+    )
+    np.testing.assert_allclose(got, [-0.2, -0.4])
+
+
+def test_contacts_with_boxes_robots_and_discs_are_found_with_exact_depths():
+    checker = CollisionChecker(BOXES, np.array([0.3, 0.3, 0.3]), margin_m=0.1)
+    x = np.array([3.0, 8.0, 8.5])
+    y = np.array([1.9, 5.0, 5.0])
+    discs = np.array([[3.0, 1.45, 0.2]])
+    near, clearance = checker.check(x, y, discs)
+    found = {(p.robot, p.kind, p.other): p.clearance_m for p in near}
+    assert found[(0, OtherKind.STATIC, 0)] == pytest.approx(-0.2)
+    assert found[(1, OtherKind.ROBOT, 2)] == pytest.approx(-0.1)
+    assert found[(0, OtherKind.DYNAMIC, 0)] == pytest.approx(0.45 - 0.5)
+    assert clearance == pytest.approx(-0.2)
+
+
+def test_pairs_beyond_the_margin_are_not_reported_but_set_the_smallest_clearance():
+    checker = CollisionChecker(BOXES, np.array([0.3, 0.3]), margin_m=0.1)
+    x = np.array([1.0, 9.0])
+    y = np.array([1.0, 9.0])
+    near, clearance = checker.check(x, y)
+    assert near == []
+    # robot 0 to box 0 corner (2, 2): hypot(1, 1) - 0.3
+    assert clearance == pytest.approx(math.sqrt(2) - 0.3, abs=1e-5)
+
+
+def test_robot_pairs_between_one_and_two_margins_apart_give_their_exact_clearance():
+    checker = CollisionChecker(np.zeros((0, 4)), np.array([0.3, 0.3]), margin_m=0.1)
+    near, clearance = checker.check(np.array([0.0, 0.75]), np.array([0.0, 0.0]))
+    assert near == []
+    assert clearance == pytest.approx(0.15)
+
+
+def test_random_configurations_agree_with_shapely():
+    rng = np.random.default_rng(4)
+    boxes = np.array([[1.0, 1.0, 3.0, 1.8], [4.0, 4.0, 4.8, 6.0], [0.0, 6.0, 2.0, 6.4]])
+    radii = np.full(6, 0.3)
+    checker = CollisionChecker(boxes, radii, margin_m=0.1)
+    for _ in range(50):
+        x = rng.uniform(0, 7, 6)
+        y = rng.uniform(0, 7, 6)
+        _, clearance = checker.check(x, y)
+        discs = [Point(xi, yi).buffer(0.3, quad_segs=256) for xi, yi in zip(x, y, strict=True)]
+        rects = [box(*b) for b in boxes]
+        gaps = [d.distance(r) for d in discs for r in rects]
+        gaps += [
+            math.hypot(x[i] - x[j], y[i] - y[j]) - 0.6 for i in range(6) for j in range(i + 1, 6)
+        ]
+        overlap = any(d.intersects(r) for d in discs for r in rects) or min(gaps) < 0
+        if not overlap:
+            assert clearance == pytest.approx(min(gaps), abs=1e-3)
+        else:
+            assert clearance < 1e-9
