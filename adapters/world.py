@@ -10,8 +10,9 @@ from cosim.errors import ScenarioError
 from cosim.hosts import BASE_HOST, HostKind
 from cosim.scenario.model import Scenario
 from models.errors import ModelError
+from models.layout import WarehouseSpec
 from models.obstacles import DynamicObstacles
-from models.world import Warehouse, WarehouseSpec, generate_warehouse
+from models.world import Warehouse, generate_warehouse
 
 
 def warehouse_spec(run: RunContext) -> WarehouseSpec:

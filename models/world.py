@@ -273,3 +273,14 @@ def generate_warehouse(spec: WarehouseSpec, rng: np.random.Generator) -> Warehou
         dock_depth_m=dock,
         obstacles=obstacles,
     )
+
+
+__all__ = [
+    "Warehouse",
+    "WarehouseSpec",
+    "box_distance",
+    "box_segments",
+    "dock_depth",
+    "dock_rows",
+    "generate_warehouse",
+]
