@@ -9,6 +9,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 from lidar_bench import lidar_rays_per_second
+from network_bench import network_deliveries_per_second
 
 import cosim
 from cosim.adapter import RunContext
@@ -160,6 +161,7 @@ SUITES: dict[str, Callable[[int], Result]] = {
     "warehouse_random_60s": warehouse_random_60s,
     "kernel_periodic_1000": kernel_periodic_1000,
     "lidar": lidar,
+    "network": network_deliveries_per_second,
     "fleet50_physics": fleet50_physics,
     "fleet50_wander": fleet50_wander,
     "fleet1000_wander": fleet1000_wander,

@@ -8,7 +8,7 @@ adapters exist, and asked for its summary metrics at the end.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, ClassVar, Protocol, TypeVar, runtime_checkable
 
@@ -43,6 +43,20 @@ class RunContext:
     recorder: Recorder
     hosts: dict[HostId, Host] = field(default_factory=dict)
     _services: dict[type[Any], Any] = field(default_factory=dict)
+    _checks: list[Callable[[], None]] = field(default_factory=list)
+
+    def check_when_assembled(self, check: Callable[[], None]) -> None:
+        """Run ``check()`` once every adapter is constructed (e.g. to validate host names).
+
+        Checks run in registration order, before any adapter starts, also for ``cosim
+        check``; a check raises a :class:`~cosim.errors.CosimError` to refuse the scenario.
+        """
+        self._checks.append(check)
+
+    def run_checks(self) -> None:
+        """Run the checks registered with :meth:`check_when_assembled`."""
+        for check in self._checks:
+            check()
 
     def add_host(self, host_id: str, kind: HostKind) -> HostId:
         """Create a host; creating the same host twice with the same kind is allowed."""

@@ -26,7 +26,7 @@ def adapter_names(scenario: Scenario) -> list[str]:
             f"{scenario.source}: [robots] driver = 'wander': expected lidar.beams > 0 "
             "(wander steers by the lidar)"
         )
-    names = ["world", "fleet", "collisions"]
+    names = ["world", "fleet", "network", "collisions"]
     if scenario.lidar.beams > 0:
         names.append("lidar")
     names += [scenario.robots.driver, "poses"]
@@ -68,4 +68,5 @@ def assemble(
     adapters: list[tuple[str, Adapter]] = []
     for name in ordered:
         adapters.append((name, registry.get(name)(run)))
+    run.run_checks()
     return Assembly(run, adapters)

@@ -90,7 +90,7 @@ def execute(
         "python": platform.python_version(),
         "sim_time_s": duration_s,
         "wall_time_s": round(wall_s, 4),
-        "real_time_factor": round(duration_s / wall_s, 2) if wall_s > 0 else float("inf"),
+        "real_time_factor": round(duration_s / wall_s, 2) if wall_s > 0 else None,
         "events": events,
         "messages_sent": sent,
         "messages_delivered": counts["delivered"],
@@ -137,7 +137,7 @@ def write_run(result: RunResult, out: Path, *, tables: bool = True) -> None:
             for name, frame in result.tables.items():
                 frame.to_parquet(partial / "tables" / f"{name}.parquet", index=False)
         (partial / "summary.json").write_text(
-            json.dumps(result.summary, indent=2) + "\n", encoding="utf-8"
+            json.dumps(result.summary, indent=2, allow_nan=False) + "\n", encoding="utf-8"
         )
         out.mkdir(parents=True, exist_ok=True)
         for entry in sorted(partial.iterdir()):

@@ -63,9 +63,17 @@ def param(
     gt: float | None = None,
     le: float | None = None,
     lt: float | None = None,
+    path: bool = False,
 ) -> Any:
-    """Declare a configuration field with a default, a one-line doc and numeric bounds."""
-    return field(default=default, metadata={"doc": doc, "bounds": Bounds(ge, gt, le, lt)})
+    """Declare a configuration field with a default, a one-line doc and numeric bounds.
+
+    ``path=True`` marks a file name: a relative one is resolved against the folder of the
+    scenario file when the scenario is loaded (against the working folder for presets and
+    ``--set``), so the resolved scenario names an absolute file.
+    """
+    return field(
+        default=default, metadata={"doc": doc, "bounds": Bounds(ge, gt, le, lt), "path": path}
+    )
 
 
 @dataclass(frozen=True, slots=True)
@@ -179,6 +187,8 @@ def _show(value: Any) -> str:
         return "true" if value else "false"
     if isinstance(value, list | tuple):
         return "[" + ", ".join(_show(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{k} = {_show(v)}" for k, v in value.items()) + "}"
     return repr(value)
 
 
@@ -229,6 +239,10 @@ def build(
                 f"{origin}: [{section}] unknown key {key!r}" + suggest(key, list(fields))
             )
         hint = hints[key]
+        nested = _table_item_type(hint)
+        if nested is not None:
+            values[key] = _build_tables(nested, raw, section=f"{section}.{key}", origin=origin)
+            continue
         bounds: Bounds = fields[key].metadata.get("bounds", Bounds())
         bound_text = bounds.describe()
         try:
@@ -252,6 +266,28 @@ def build(
                 format_problem(origin, section, problem.key, problem.value, problem.expected)
             )
     return instance
+
+
+def _table_item_type(hint: Any) -> type[Any] | None:
+    """The dataclass ``X`` of a ``tuple[X, ...]`` annotation (an array of tables), or None."""
+    if get_origin(hint) is tuple:
+        args = get_args(hint)
+        if len(args) == 2 and args[1] is Ellipsis and dataclasses.is_dataclass(args[0]):
+            return args[0]  # type: ignore[return-value]
+    return None
+
+
+def _build_tables(cls: type[T], raw: Any, *, section: str, origin: str) -> tuple[T, ...]:
+    """Validate an array of tables (``[[section.key]]``) into a tuple of dataclasses."""
+    if not isinstance(raw, list | tuple) or not all(isinstance(item, dict) for item in raw):
+        raise ConfigError(
+            f"{origin}: [{section}] = {_show(raw)}: expected a list of tables "
+            f"({', '.join(field_names(cls))})"
+        )
+    return tuple(
+        build(cls, item, section=f"{section}[{i}]", origins={}, default_origin=origin)
+        for i, item in enumerate(raw)
+    )
 
 
 def docs(cls: type[Any]) -> dict[str, str]:

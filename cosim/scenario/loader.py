@@ -6,7 +6,7 @@ import copy
 import math
 import tomllib
 from collections.abc import Mapping
-from dataclasses import fields
+from dataclasses import fields, is_dataclass, replace
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -133,10 +133,51 @@ def _build(raw: dict[str, Any], origin: str, origins: dict[tuple[str, str], str]
                 f"{origin}: {section} = {table!r}: expected a [{section}] table of keys"
             )
         key_origins = {key: origins.get((section, key), origin) for key in table}
-        built[section] = build(
-            types[section], table, section=section, origins=key_origins, default_origin=origin
+        table, key_origins = _apply_profile(types[section], table, key_origins, section, origin)
+        built[section] = _resolve_paths(
+            build(
+                types[section], table, section=section, origins=key_origins, default_origin=origin
+            ),
+            key_origins,
         )
     return Scenario(**built, source=origin)
+
+
+def _resolve_paths(section: Any, origins: Mapping[str, str]) -> Any:
+    """Make the relative file names of a section absolute (see ``param(path=True)``)."""
+    changes = {}
+    for f in fields(section):
+        value = getattr(section, f.name)
+        if not f.metadata.get("path") or not value or Path(value).is_absolute():
+            continue
+        origin = Path(origins.get(f.name, ""))
+        base = origin.parent if origin.suffix == ".toml" and origin.is_file() else Path.cwd()
+        changes[f.name] = str((base / value).resolve())
+    return replace(section, **changes) if changes else section
+
+
+def _apply_profile(
+    cls: type[Any],
+    table: dict[str, Any],
+    origins: dict[str, str],
+    section: str,
+    origin: str,
+) -> tuple[dict[str, Any], dict[str, str]]:
+    """Fill a section's keys from its profile (``PROFILES``); given keys win."""
+    profiles = getattr(cls, "PROFILES", None)
+    if profiles is None:
+        return table, origins
+    name = table.get("profile", cls().profile)
+    if name not in profiles:
+        where = origins.get("profile", origin)
+        raise ConfigError(
+            f"{where}: [{section}] profile = {name!r}: expected one of "
+            + ", ".join(repr(p) for p in profiles)
+            + suggest(str(name), list(profiles))
+        )
+    merged = {**profiles[name], **table}
+    merged_origins = {key: origins.get(key, f"{origin} (profile {name})") for key in merged}
+    return merged, merged_origins
 
 
 def _toml_value(value: Any) -> str:
@@ -152,6 +193,11 @@ def _toml_value(value: Any) -> str:
         return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
     if isinstance(value, list | tuple):
         return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    if is_dataclass(value) and not isinstance(value, type):
+        inner = ", ".join(
+            f"{f.name} = {_toml_value(getattr(value, f.name))}" for f in fields(value)
+        )
+        return "{" + inner + "}"
     raise TypeError(f"cannot write {type(value).__name__} to TOML")
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, fields, replace
 from typing import Any, get_type_hints
 
+from cosim.scenario.network import NetworkConfig
 from cosim.scenario.sections import (
     LidarConfig,
     OdometryConfig,
@@ -28,6 +29,7 @@ class Scenario:
     robots: RobotsConfig = field(default_factory=RobotsConfig)
     lidar: LidarConfig = field(default_factory=LidarConfig)
     odometry: OdometryConfig = field(default_factory=OdometryConfig)
+    network: NetworkConfig = field(default_factory=NetworkConfig)
     record: RecordConfig = field(default_factory=RecordConfig)
     source: str = field(default="<defaults>", compare=False)
 

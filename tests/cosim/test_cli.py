@@ -8,6 +8,8 @@ import pytest
 
 from cosim.cli import main
 
+REPO_ROOT = Path(__file__).resolve().parents[2]
+
 SMALL = [
     "--set",
     "world.size_m=[12.0, 12.0]",
@@ -232,3 +234,57 @@ def test_wander_without_a_lidar_is_refused_naming_the_keys(tmp_path):
     )
     assert done.returncode == 2
     assert "driver = 'wander': expected lidar.beams > 0" in done.stderr
+
+
+@pytest.mark.parametrize(
+    ("setting", "fragment"),
+    [
+        ("network.latency_ms=-5", "[network] latency_ms = -5: expected a number >= 0"),
+        ("network.loss_prob=1.5", "[network] loss_prob = 1.5: expected a number >= 0 and <= 1"),
+        ("network.ge_p=-0.1", "[network] ge_p = -0.1: expected a number >= 0 and <= 1"),
+        ("network.profile=wifi_bad", "profile = 'wifi_bad': expected one of 'ideal'"),
+        ("network.topology=star", "topology = 'star': expected one of 'complete'"),
+        ("network.loss_prob=0.2", "loss_prob = 0.2: expected 0 with loss_model 'none'"),
+        (
+            'network.partitions=[{from_s=1.0, to_s=2.0, hosts=["robot_42"]}]',
+            "names host 'robot_42'",
+        ),
+        (
+            'network.partitions=[{from_s=2.0, to_s=1.0, hosts=["base"]}]',
+            "[network.partitions[0]] to_s = 1.0: expected a time after from_s",
+        ),
+    ],
+)
+def test_invalid_network_settings_exit_2_naming_the_key(tmp_path, setting, fragment):
+    done = cosim_cli("check", "warehouse-random", "--set", setting, cwd=tmp_path)
+    assert done.returncode == 2, done.stdout
+    assert fragment in done.stderr
+    assert done.stderr.count("\n") == 1, done.stderr
+
+
+@pytest.mark.parametrize(
+    ("content", "fragment"),
+    [
+        ("", "latency_csv"),
+        ("delay_ms\n1.0\nabc\n", "line 3"),
+        ("delay_ms\n1.0\n-2.0\n", "line 3"),
+    ],
+)
+def test_an_empty_or_malformed_delay_csv_exits_2_naming_the_file(tmp_path, content, fragment):
+    (tmp_path / "delays.csv").write_text(content)
+    scenario = tmp_path / "s.toml"
+    scenario.write_text('[network]\nlatency_model = "empirical"\nlatency_csv = "delays.csv"\n')
+    done = cosim_cli("check", str(scenario))
+    assert done.returncode == 2, done.stdout
+    assert "latency_csv" in done.stderr and "delays.csv" in done.stderr
+    assert fragment in done.stderr
+    assert done.stderr.count("\n") == 1, done.stderr
+
+
+def test_a_delay_csv_next_to_the_scenario_is_found_and_used(tmp_path):
+    (tmp_path / "delays.csv").write_text("delay_ms\n4.0\n4.0\n6.0\n")
+    scenario = tmp_path / "s.toml"
+    scenario.write_text('[network]\nlatency_model = "empirical"\nlatency_csv = "delays.csv"\n')
+    done = cosim_cli("check", str(scenario), "--print", cwd=REPO_ROOT)
+    assert done.returncode == 0, done.stderr
+    assert f'latency_csv = "{tmp_path / "delays.csv"}"' in done.stdout

@@ -145,3 +145,45 @@ def test_the_resolved_dump_loads_back_to_an_equal_scenario():
     text = dump_scenario(scenario)
     assert scenario_from_text(text, "dump") == scenario
     assert "[robots]" in text and "[lidar]" in text
+
+
+def test_a_network_profile_fills_the_link_keys_and_explicit_keys_override_it(tmp_path):
+    path = _write(tmp_path, '[network]\nprofile = "wifi_degraded"\nlatency_ms = 7.5\n')
+    network = cosim.load_scenario(path).network
+    assert network.latency_ms == 7.5
+    assert network.loss_model == "gilbert_elliott"
+    assert network.bandwidth_mbps == 10.0
+
+
+def test_an_unknown_network_profile_suggests_the_nearest(tmp_path):
+    with pytest.raises(ConfigError, match=r"profile = 'wifi_nominl'.*did you mean 'wifi_nominal'"):
+        cosim.load_scenario(_write(tmp_path, '[network]\nprofile = "wifi_nominl"\n'))
+
+
+def test_a_problem_coming_from_a_profile_says_so(tmp_path):
+    path = _write(tmp_path, '[network]\nprofile = "wifi_nominal"\nloss_model = "none"\n')
+    with pytest.raises(
+        ConfigError, match=r"\(profile wifi_nominal\): \[network\] loss_prob = 0.01"
+    ):
+        cosim.load_scenario(path)
+
+
+def test_partitions_are_validated_as_tables_and_round_trip_through_the_dump():
+    scenario = cosim.load_scenario(
+        "warehouse-random",
+        {
+            "network.partitions": [
+                {"from_s": 1.0, "to_s": 2.5, "hosts": ["robot_1", "base"]},
+                {"from_s": 3.0, "to_s": 4.0, "links": [["robot_1", "robot_2"]]},
+            ]
+        },
+    )
+    assert scenario.network.partitions[1].links == (("robot_1", "robot_2"),)
+    assert scenario_from_text(dump_scenario(scenario), "dump") == scenario
+
+
+def test_an_unknown_key_inside_a_partition_is_named_with_its_index():
+    with pytest.raises(ConfigError, match=r"\[network.partitions\[0\]\] unknown key 'form_s'"):
+        cosim.load_scenario(
+            "warehouse-random", {"network.partitions": [{"form_s": 1.0, "to_s": 2.0}]}
+        )
