@@ -13,7 +13,10 @@ from network_bench import network_deliveries_per_second
 
 import cosim
 from cosim.adapter import RunContext
+from cosim.bus import Envelope
+from cosim.hosts import BASE_HOST, HostId
 from cosim.kernel import Kernel, Stage
+from cosim.messages import Message, Twist
 from cosim.registry import AdapterRegistry
 from cosim.runner import execute
 from models.kinematics import FleetState
@@ -152,6 +155,75 @@ def fleet1000_wander(repeat: int) -> Result:
     return {"hall_m": [100.0, 100.0], "shelves": 600, **_rtf_runs(scenario, max(1, repeat - 2))}
 
 
+def network_end_to_end(repeat: int) -> Result:
+    """Messages through bus + network model + kernel delivery events, per second of wall time.
+
+    10 robots each publish a Twist to the base every millisecond for 2 s of sim time under
+    the wifi_nominal profile: every message is decided by the model, scheduled as a kernel
+    event and handed to a subscriber.
+    """
+    scenario = cosim.load_scenario(
+        "warehouse-random",
+        {
+            "robots.count": 10,
+            "lidar.beams": 0,
+            "network.profile": "wifi_nominal",
+            "network.bandwidth_mbps": 0.0,
+            "scenario.duration_s": 2.0,
+            "record.messages": False,
+        },
+    )
+    registry = AdapterRegistry.from_entry_points().with_adapter(Chatter)
+    rates, delivered = [], 0
+    for seed in range(1, repeat + 1):
+        Chatter.received = 0
+        start = time.perf_counter()
+        execute(
+            scenario.with_seed(seed),
+            names=["world", "fleet", "network", "chatter"],
+            registry=registry,
+        )
+        wall = time.perf_counter() - start
+        delivered = Chatter.received
+        rates.append(delivered / wall)
+    return {
+        "robots": 10,
+        "messages_per_sim_s": 10_000,
+        "profile": "wifi_nominal",
+        "deliveries_last": delivered,
+        "deliveries_per_s_median": round(statistics.median(rates)),
+        "note": "includes run set-up (world, adapters) in the wall time",
+        "repeat": repeat,
+    }
+
+
+class Chatter:
+    """Bench-only traffic: every robot sends a Twist to the base every millisecond."""
+
+    name: ClassVar[str] = "chatter"
+    requires: ClassVar[tuple[str, ...]] = ("network",)
+    received: ClassVar[int] = 0
+
+    def __init__(self, run: RunContext) -> None:
+        self.hosts = [HostId(n) for n in run.service(FleetState).names]
+
+    def start(self, run: RunContext) -> None:
+        def count(message: Message, envelope: Envelope) -> None:
+            Chatter.received += 1
+
+        run.bus.subscribe("/fleet/cmd", BASE_HOST, count)
+        twist = Twist(0.5, 0.1)
+
+        def send(now: int) -> None:
+            for host in self.hosts:
+                run.bus.publish("/fleet/cmd", twist, host)
+
+        run.kernel.every(1_000_000, send, stage=Stage.CONTROL)
+
+    def finish(self, run: RunContext) -> dict[str, Any]:
+        return {}
+
+
 def lidar(repeat: int) -> Result:
     """Grid ray caster throughput, one core (see bench/lidar_bench.py)."""
     return lidar_rays_per_second(max(repeat, 20))
@@ -162,6 +234,7 @@ SUITES: dict[str, Callable[[int], Result]] = {
     "kernel_periodic_1000": kernel_periodic_1000,
     "lidar": lidar,
     "network": network_deliveries_per_second,
+    "network_end_to_end": network_end_to_end,
     "fleet50_physics": fleet50_physics,
     "fleet50_wander": fleet50_wander,
     "fleet1000_wander": fleet1000_wander,
