@@ -8,8 +8,10 @@ from collections.abc import Callable
 from typing import Any, ClassVar
 
 import numpy as np
+from dwa_bench import dwa_us_per_robot
 from lidar_bench import lidar_rays_per_second
 from network_bench import network_deliveries_per_second
+from planner_bench import planner_ms
 
 import cosim
 from cosim.adapter import RunContext
@@ -224,6 +226,43 @@ class Chatter:
         return {}
 
 
+BREAKDOWN = {
+    "lidar (cast, noise, scan messages)": ("adapters/lidar.py", "_scan"),
+    "navigation control tick (all below)": ("adapters/navigation.py", "_control"),
+    "  global planning (A*, costmap, memory)": ("adapters/navigation.py", "_plan"),
+    "  local control (DWA kernel)": ("models/navigation/dwa.py", "dwa_batch"),
+    "physics tick (kinematics, collisions, odometry)": ("adapters/fleet.py", "_tick"),
+    "  collision checks": ("adapters/collisions.py", "guard"),
+    "bus publish (all messages)": ("cosim/bus.py", "publish"),
+}
+
+
+def fleet50_navigation(repeat: int) -> Result:
+    """fleet50 preset (navigation to random goals): real-time factor and where time goes."""
+    import cProfile
+    import pstats
+
+    scenario = cosim.load_scenario("fleet50", {"scenario.duration_s": 60.0})
+    runs = _rtf_runs(scenario, repeat)
+    profiler = cProfile.Profile()
+    profiler.enable()
+    result = cosim.run(scenario.with_duration(30.0))
+    profiler.disable()
+    stats = pstats.Stats(profiler).stats  # type: ignore[attr-defined]
+    total = sum(v[2] for v in stats.values())
+    shares = {}
+    for label, (path, func) in BREAKDOWN.items():
+        cum = sum(v[3] for (file, _line, name), v in stats.items()
+                  if file.endswith(path) and name == func)
+        shares[label] = round(cum / total, 3) if total else None
+    return {
+        **runs,
+        "arrivals_last": result.summary["arrivals"],
+        "breakdown_share_of_wall_time": shares,
+        "breakdown_note": "cProfile shares of a 30 s run (profiling slows the run ~30 %)",
+    }
+
+
 def lidar(repeat: int) -> Result:
     """Grid ray caster throughput, one core (see bench/lidar_bench.py)."""
     return lidar_rays_per_second(max(repeat, 20))
@@ -235,6 +274,9 @@ SUITES: dict[str, Callable[[int], Result]] = {
     "lidar": lidar,
     "network": network_deliveries_per_second,
     "network_end_to_end": network_end_to_end,
+    "planner": planner_ms,
+    "fleet50_navigation": fleet50_navigation,
+    "dwa": dwa_us_per_robot,
     "fleet50_physics": fleet50_physics,
     "fleet50_wander": fleet50_wander,
     "fleet1000_wander": fleet1000_wander,

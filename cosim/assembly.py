@@ -13,6 +13,13 @@ from cosim.registry import AdapterRegistry
 from cosim.rng import RngStreams
 from cosim.scenario.model import Scenario
 
+DRIVERS: dict[str, list[str]] = {
+    "navigation": ["navigation", "goals"],
+    "waypoints": ["waypoints"],
+    "wander": ["wander"],
+}
+"""The adapters that make up each ``robots.driver``."""
+
 
 def adapter_names(scenario: Scenario) -> list[str]:
     """The adapters a scenario runs, before requirements are resolved.
@@ -21,15 +28,16 @@ def adapter_names(scenario: Scenario) -> list[str]:
         ConfigError: for combinations that cannot work (a lidar-driven behaviour without
             a lidar).
     """
-    if scenario.robots.driver == "wander" and scenario.lidar.beams == 0:
+    driver = scenario.robots.driver
+    if driver in ("wander", "navigation") and scenario.lidar.beams == 0:
         raise ConfigError(
-            f"{scenario.source}: [robots] driver = 'wander': expected lidar.beams > 0 "
-            "(wander steers by the lidar)"
+            f"{scenario.source}: [robots] driver = {driver!r}: expected lidar.beams > 0 "
+            "(it avoids what the lidar sees)"
         )
     names = ["world", "fleet", "network", "collisions"]
     if scenario.lidar.beams > 0:
         names.append("lidar")
-    names += [scenario.robots.driver, "poses"]
+    names += DRIVERS[driver] + ["poses"]
     names += [name for name in scenario.scenario.adapters if name not in names]
     return names
 

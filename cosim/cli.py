@@ -23,6 +23,16 @@ from cosim.scenario import (
     preset_summary,
 )
 
+HIGHLIGHTS = (
+    ("arrivals", "goals reached"),
+    ("deadlocks", "stuck reports"),
+    ("collisions", "collisions"),
+    ("min_clearance_m", "m smallest clearance"),
+    ("messages_dropped", "messages dropped"),
+    ("latency_ms_p50", "ms median latency"),
+)
+"""Summary metrics shown after a run, when the run has them."""
+
 EXIT_OK = 0
 EXIT_BUG = 1
 EXIT_INPUT = 2
@@ -176,6 +186,11 @@ def _cmd_run(args: argparse.Namespace) -> int:
             f"{s['wall_time_s']:.2f} s ({s['real_time_factor']:g}x real time), "
             f"{s['robots']} robots, {s['events']} events, {s['messages_sent']} messages"
         )
+        highlights = [
+            f"{s[key]} {label}" for key, label in HIGHLIGHTS if s.get(key) is not None
+        ]
+        if highlights:
+            print("  " + ", ".join(highlights))
         tables = ", ".join(sorted(result.tables))
         print(f"results: {out}/  (summary.json, scenario.toml, tables/: {tables})")
     return EXIT_OK

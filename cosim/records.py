@@ -132,6 +132,7 @@ class Recorder:
         self._chunks: list[dict[str, npt.NDArray[Any]]] = []
         self._events = Table(("t_ns", "source", "kind", "detail"))
         self.tables: dict[str, Table] = {}
+        self.volatile: dict[str, tuple[str, ...]] = {}
         self.counts: dict[str, int] = {status.value: 0 for status in DeliveryStatus}
 
     # -- the bus tap ---------------------------------------------------------------
@@ -179,12 +180,32 @@ class Recorder:
         """Record a discrete event (``source`` is the component, ``kind`` a short verb)."""
         self._events.append(t_ns=t_ns, source=source, kind=kind, detail=detail)
 
-    def table(self, name: str, columns: Sequence[str], categorical: Iterable[str] = ()) -> Table:
-        """Create (once) and return the table ``name``; it is exported as ``tables/NAME``."""
+    def table(
+        self,
+        name: str,
+        columns: Sequence[str],
+        categorical: Iterable[str] = (),
+        *,
+        volatile: Iterable[str] = (),
+    ) -> Table:
+        """Create (once) and return the table ``name``; it is exported as ``tables/NAME``.
+
+        Args:
+            name: table name.
+            columns: column names, in order.
+            categorical: columns of repeated strings.
+            volatile: wall-clock columns (e.g. a planning time in ms): the only values
+                that are not a function of the scenario and seed; comparisons of runs
+                leave them out (see :attr:`volatile`).
+        """
         if name in self.tables or name in ("messages", "events"):
             raise ValueError(f"table {name!r} exists already")
         table = Table(columns, categorical)
         self.tables[name] = table
+        for column in volatile:
+            if column not in columns:
+                raise ValueError(f"volatile column {column!r} is not a column of {name!r}")
+        self.volatile[name] = tuple(volatile)
         return table
 
     # -- export ----------------------------------------------------------------------

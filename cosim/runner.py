@@ -44,6 +44,14 @@ class RunResult:
     summary: dict[str, Any]
     tables: dict[str, pd.DataFrame] = field(repr=False)
     out: Path | None = None
+    volatile: dict[str, tuple[str, ...]] = field(default_factory=dict, repr=False)
+
+    def deterministic_tables(self) -> dict[str, pd.DataFrame]:
+        """The tables without their wall-clock columns: equal for equal scenario and seed."""
+        return {
+            name: frame.drop(columns=list(self.volatile.get(name, ())))
+            for name, frame in self.tables.items()
+        }
 
 
 def cosim_version() -> str:
@@ -101,7 +109,7 @@ def execute(
             merge_counts(summary, adapter.finish(run))
         except ValueError as error:
             raise RuntimeError(f"adapter {name!r}: {error}") from error
-    return RunResult(scenario, summary, run.recorder.frames())
+    return RunResult(scenario, summary, run.recorder.frames(), volatile=run.recorder.volatile)
 
 
 def prepare_out(out: Path, *, force: bool) -> None:

@@ -18,6 +18,7 @@ SMALL = {
     "world.shelf_count": 4,
     "robots.count": 3,
     "lidar.beams": 90,
+    "robots.driver": "waypoints",
 }
 
 

@@ -8,6 +8,7 @@ from typing import Any, get_type_hints
 from cosim.scenario.network import NetworkConfig
 from cosim.scenario.sections import (
     LidarConfig,
+    NavigationConfig,
     OdometryConfig,
     RecordConfig,
     RobotsConfig,
@@ -30,6 +31,7 @@ class Scenario:
     lidar: LidarConfig = field(default_factory=LidarConfig)
     odometry: OdometryConfig = field(default_factory=OdometryConfig)
     network: NetworkConfig = field(default_factory=NetworkConfig)
+    navigation: NavigationConfig = field(default_factory=NavigationConfig)
     record: RecordConfig = field(default_factory=RecordConfig)
     source: str = field(default="<defaults>", compare=False)
 

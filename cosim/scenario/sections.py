@@ -78,9 +78,10 @@ class RobotsConfig:
     max_yaw_accel_radps2: float = param(3.0, "yaw acceleration limit (rad/s^2)", gt=0)
     radius_m: float = param(0.33, "footprint radius (m)", gt=0)
     control_hz: float = param(20.0, "kinematics and odometry rate (Hz)", gt=0, le=1000)
-    driver: Literal["waypoints", "wander"] = param(
-        "waypoints",
-        "robot behaviour: straight-line random waypoints, or reactive lidar wandering",
+    driver: Literal["navigation", "waypoints", "wander"] = param(
+        "navigation",
+        "robot software: navigation to random reachable goals (the Nav2 role), straight-line "
+        "waypoints without avoidance, or reactive lidar wandering",
     )
 
     def problems(self) -> Iterator[Problem]:
@@ -141,3 +142,40 @@ class RecordConfig:
     pose_rate_hz: float = param(10.0, "ground-truth pose sampling rate for tables/poses (Hz)", gt=0)
     messages: bool = param(True, "keep one row per message in tables/messages")
     tables: bool = param(True, "write tables/*.parquet")
+
+
+@dataclass(frozen=True)
+class NavigationConfig:
+    """``[navigation]``: the Nav2 role, global planning and local control on every robot.
+
+    Defaults follow Nav2's where it has one: a 1 Hz replanning cadence as in its
+    ``navigate_to_pose`` behaviour tree (``RateController hz=1.0``), a 10 Hz local
+    controller, a 0.25 m goal tolerance (``xy_goal_tolerance``). Inflation uses a 1 m radius
+    with scaling 3 (Nav2's code defaults are 0.55 m and 10; the gentler slope keeps robots
+    in the middle of 1.6 m aisles). ``stuck`` comes after 30 s without progress: with 50
+    robots in one hall, 10 s (Nav2's progress checker) mostly flags robots that are merely
+    slowed by traffic and would arrive (measured: 44 of 214 goals vs 3 of 166 in 120 s).
+    """
+
+    planner: Literal["astar"] = param("astar", "global planner on the costmap")
+    controller: Literal["dwa"] = param("dwa", "local controller")
+    replan_hz: float = param(1.0, "periodic global replanning rate (Hz)", gt=0, le=50)
+    control_hz: float = param(10.0, "local controller rate (Hz)", gt=0, le=100)
+    robots_layer: bool = param(
+        False, "robots broadcast pose and footprint over the network; others avoid them"
+    )
+    robots_layer_hz: float = param(5.0, "robots layer broadcast rate (Hz)", gt=0)
+    robots_layer_timeout_s: float = param(1.0, "forget a robot not heard from for (s)", gt=0)
+    resolution_m: float = param(0.1, "costmap cell size (m)", gt=0, le=1)
+    inflation_radius_m: float = param(1.0, "inflation radius (m)", gt=0)
+    cost_scaling: float = param(3.0, "inflation cost scaling factor (1/m)", gt=0)
+    lookahead_m: float = param(1.0, "carrot distance ahead on the path (m)", gt=0)
+    goal_tolerance_m: float = param(0.25, "distance at which a goal is reached (m)", gt=0)
+    obstacle_memory_s: float = param(3.0, "how long lidar obstacles stay in the costmap (s)", ge=0)
+    stuck_timeout_s: float = param(
+        30.0,
+        "no progress for this long reports `stuck` (s); the paper's robots stall 20-30 s "
+        "before the fleet layer re-targets them",
+        gt=0,
+    )
+    progress_hz: float = param(1.0, "rate of `progress` status reports (Hz)", gt=0)

@@ -11,6 +11,7 @@ SMALL = {
     "world.shelf_count": 4,
     "robots.count": 3,
     "lidar.beams": 0,
+    "robots.driver": "waypoints",
 }
 
 

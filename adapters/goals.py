@@ -1,0 +1,82 @@
+"""Random reachable goals for every robot, through the navigation interface.
+
+Until tasks exist, each robot gets a stream of goals: a free cell of the inflated static
+map, drawn from the robot's own random stream, in the same connected free region as the
+robot; a new one when the previous is reached, found unreachable, or reported stuck (as a
+fleet manager would re-target a stalled robot).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from typing import Any, ClassVar
+
+import numpy as np
+from scipy import ndimage
+
+from adapters.naming import topic
+from cosim.adapter import RunContext
+from cosim.bus import Envelope
+from cosim.hosts import HostId
+from cosim.messages import Message, NavGoal, NavStatus
+from models.kinematics import FleetState
+from models.navigation.costmap import StaticCostmap
+
+GOAL_CLEARANCE_M = 0.3
+"""Free space kept around a goal beyond the footprint (m)."""
+
+
+class GoalsAdapter:
+    """Sends each robot random reachable goals, one after another."""
+
+    name: ClassVar[str] = "goals"
+    requires: ClassVar[tuple[str, ...]] = ("navigation",)
+
+    def __init__(self, run: RunContext) -> None:
+        fleet = run.service(FleetState)
+        self.names = list(fleet.names)
+        self.hosts = [HostId(n) for n in self.names]
+        static = run.service(StaticCostmap)
+        radius = run.scenario.robots.radius_m
+        free = static.distance_m >= radius + GOAL_CLEARANCE_M
+        labels, _ = ndimage.label(static.cost < 253, structure=np.ones((3, 3)))
+        self.static = static
+        self.cells: list[np.ndarray] = []
+        for x, y in zip(fleet.x, fleet.y, strict=True):
+            ix, iy = static.world_to_cell((x, y))
+            region = labels == labels[iy, ix] if labels[iy, ix] else np.zeros_like(free)
+            self.cells.append(np.argwhere(free & region))  # (k, 2) as (iy, ix)
+        self.rngs = [run.rng.stream(f"goals/{n}") for n in self.names]
+        self.next_id = np.zeros(len(self.names), dtype=np.int64)
+        self.sent = 0
+
+    def start(self, run: RunContext) -> None:
+        """Listen to every robot's navigation status and send the first goals."""
+        for i, (name, host) in enumerate(zip(self.names, self.hosts, strict=True)):
+            run.bus.subscribe(topic(name, "nav/status"), host, self._on_status(run, i))
+        for i in range(len(self.names)):
+            self._send(run, i)
+
+    def _on_status(self, run: RunContext, i: int) -> Callable[[Message, Envelope], None]:
+        def on_status(message: Message, _envelope: Envelope) -> None:
+            assert isinstance(message, NavStatus)
+            current = message.goal_id == self.next_id[i] - 1
+            if current and message.state in ("arrived", "unreachable", "stuck"):
+                self._send(run, i)
+
+        return on_status
+
+    def _send(self, run: RunContext, i: int) -> None:
+        cells = self.cells[i]
+        if not len(cells):
+            return
+        iy, ix = cells[int(self.rngs[i].integers(len(cells)))]
+        x, y = self.static.cell_to_world((int(ix), int(iy)))
+        goal = NavGoal(run.kernel.now_ns, int(self.next_id[i]), float(x), float(y))
+        self.next_id[i] += 1
+        self.sent += 1
+        run.bus.publish(topic(self.names[i], "nav/goal"), goal, self.hosts[i])
+
+    def finish(self, run: RunContext) -> Mapping[str, Any]:
+        """Goals sent."""
+        return {"goals_sent": self.sent}

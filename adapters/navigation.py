@@ -1,0 +1,422 @@
+"""The navigation adapter: the Nav2 role on every robot.
+
+Interface (per robot, on the robot's host): a :class:`~cosim.messages.NavGoal` on
+``/<robot>/nav/goal`` means "go to (x, y)"; the adapter answers on ``/<robot>/nav/status``
+with ``accepted``, periodic ``progress``, ``arrived``, ``stuck`` (no progress for
+``navigation.stuck_timeout_s``; it keeps trying) and ``unreachable`` (outside the map,
+inside an obstacle, or enclosed on the static map; the goal is dropped).
+
+Each robot plans on its own costmap: the static layer (pluggable through the
+:class:`StaticLayer` service; the ground-truth map by default) inflated once, plus the
+lidar hits it remembers and, with ``navigation.robots_layer``, the other robots' discs
+heard over the network. A* gives the global path (replanned at ``replan_hz``, when the
+controller is blocked, and after recoveries); a batched Dynamic Window Approach follows
+it at ``control_hz``, keeping clear of the latest scan's hits. Blocked robots recover:
+wait, rotate, back up, replan.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Mapping
+from typing import Any, ClassVar
+
+import numpy as np
+
+from adapters.fleet import drive_limits
+from adapters.naming import topic
+from adapters.nav_records import NavRecords
+from adapters.nav_recovery import Recovery
+from adapters.scan_memory import MovingMemory, ScanMemory
+from cosim.adapter import RunContext
+from cosim.bus import Envelope
+from cosim.errors import ConfigError
+from cosim.hosts import HostId
+from cosim.kernel import Stage
+from cosim.messages import LaserScan, Message, NavGoal, NavStatus, Odometry, RobotState, Twist
+from cosim.timebase import NS_PER_S, period_ns, s_to_ns
+from models.kinematics import FleetState
+from models.lidar import ScanGeometry
+from models.navigation.costmap import CostmapParams, StaticCostmap, with_obstacles
+from models.navigation.dwa import DwaParams, dwa_batch
+from models.navigation.follow import PathBook, paths_blocked
+from models.navigation.planner import (
+    GoalStatus,
+    goal_status,
+    path_to_world,
+    plan,
+    prune_path,
+    shortest_path_length_m,
+)
+from models.navigation.traffic import TrafficParams, keep_right, moving_points, speed_caps
+from models.occupancy import OccupancyGrid, ground_truth_grid
+from models.world import Warehouse
+
+ROBOT_STATES = "/fleet/robot_states"
+PROGRESS_M = 0.2
+"""Remaining path length must shrink by this much to count as progress (m)."""
+PATH_CLEARANCE_M = 0.3
+"""A moving thing closer than footprint plus this to the path ahead calls for a replan (m)."""
+HALT_MPS = 0.02
+"""Commanded speed below which a robot with a goal counts as halted (m/s)..."""
+HALT_RADPS = 0.05
+"""...when it does not turn faster than this either (rad/s)."""
+
+
+class StaticLayer:
+    """The static map navigation plans on; a later mapping adapter may provide its own.
+
+    Attributes:
+        grid: the occupancy grid (``map`` frame).
+    """
+
+    def __init__(self, grid: OccupancyGrid) -> None:
+        self.grid = grid
+
+
+class NavigationAdapter:
+    """Global planning, local control, recovery and status reports for every robot."""
+
+    name: ClassVar[str] = "navigation"
+    requires: ClassVar[tuple[str, ...]] = ("world", "fleet", "lidar")
+
+    def __init__(self, run: RunContext) -> None:
+        cfg = run.scenario.navigation
+        if run.scenario.lidar.beams == 0:
+            raise ConfigError(
+                f"{run.scenario.source}: [robots] driver = 'navigation': expected lidar.beams "
+                "> 0 (the local controller avoids what the lidar sees)"
+            )
+        self.cfg = cfg
+        self.fleet = run.service(FleetState)
+        self.names = list(self.fleet.names)
+        self.hosts = [HostId(n) for n in self.names]
+        n = len(self.names)
+        radius = run.scenario.robots.radius_m
+        if not run.has_service(StaticLayer):
+            run.provide(StaticLayer(ground_truth_grid(run.service(Warehouse), cfg.resolution_m)))
+        self.params = CostmapParams(radius, cfg.inflation_radius_m, cfg.cost_scaling)
+        self.static = StaticCostmap.from_grid(run.service(StaticLayer).grid, self.params)
+        run.provide(self.static)
+        self.limits = drive_limits(run)
+        self.dwa = DwaParams(control_period_s=1.0 / cfg.control_hz)
+        self.period_ns = period_ns(cfg.control_hz)
+        lidar = run.scenario.lidar
+        angles = _beam_angles(lidar.beams, math.radians(lidar.fov_deg))
+        self.memory = ScanMemory(n, angles, lidar.range_max_m)
+        self.moving = MovingMemory(s_to_ns(cfg.obstacle_memory_s))
+        self.planned_around = np.zeros(n, dtype=bool)
+        self.near_m = self.limits.max_speed_mps * self.dwa.sim_time_s + radius + 1.0
+        self.paths = PathBook(n)
+        self.pose = np.stack([self.fleet.x, self.fleet.y, self.fleet.yaw], axis=1)
+        self.vel = np.zeros((n, 2))
+        self.active = np.zeros(n, dtype=bool)
+        self.goal = np.zeros((n, 2))
+        self.goal_id = np.zeros(n, dtype=np.int64)
+        self.next_plan_ns = np.zeros(n, dtype=np.int64)
+        self.best_remaining = np.full(n, np.inf)
+        self.progress_ns = np.zeros(n, dtype=np.int64)
+        self.stuck = np.zeros(n, dtype=bool)
+        self.others: list[dict[int, tuple[float, float, float, int]]] = [{} for _ in range(n)]
+        self.records = NavRecords(run.recorder, self.names)
+        self.radius = radius
+        self.rngs = [run.rng.stream(f"navigation/{name}") for name in self.names]
+        self.traffic = TrafficParams()
+        self.recovery = Recovery(n, self.memory, self.limits, radius, self.rngs)
+
+    # -- the bus ----------------------------------------------------------------------
+    def start(self, run: RunContext) -> None:
+        """Subscribe to goals, odometry and scans; start control, status and robots layer."""
+        bus = run.bus
+        self.status_topics = [topic(n, "nav/status") for n in self.names]
+        self.cmd_topics = [topic(n, "cmd_vel") for n in self.names]
+        for i, (name, host) in enumerate(zip(self.names, self.hosts, strict=True)):
+            bus.subscribe(topic(name, "nav/goal"), host, self._on_goal(run, i))
+            bus.subscribe(topic(name, "odom"), host, self._on_odom(i))
+            bus.subscribe(topic(name, "scan"), host, self._on_scan(i))
+        kernel = run.kernel
+        kernel.every(self.period_ns, lambda now: self._control(run, now), stage=Stage.CONTROL)
+        kernel.every(
+            period_ns(self.cfg.progress_hz),
+            lambda now: self._progress(run, now),
+            stage=Stage.CONTROL,
+        )
+        if self.cfg.robots_layer:
+            for i, host in enumerate(self.hosts):
+                bus.subscribe(ROBOT_STATES, host, self._on_robot_state(i))
+            kernel.every(
+                period_ns(self.cfg.robots_layer_hz),
+                lambda now: self._broadcast(run, now),
+                stage=Stage.CONTROL,
+            )
+
+    def _on_odom(self, i: int) -> Callable[[Message, Envelope], None]:
+        def on_odom(message: Message, _envelope: Envelope) -> None:
+            assert isinstance(message, Odometry)
+            self.pose[i] = (message.x_m, message.y_m, message.yaw_rad)
+            self.vel[i] = (message.v_mps, message.w_radps)
+
+        return on_odom
+
+    def _on_scan(self, i: int) -> Callable[[Message, Envelope], None]:
+        def on_scan(message: Message, _envelope: Envelope) -> None:
+            assert isinstance(message, LaserScan)
+            self.memory.add(i, self.pose[i].copy(), message.ranges_m)
+
+        return on_scan
+
+    def _on_robot_state(self, i: int) -> Callable[[Message, Envelope], None]:
+        me = self.names[i]
+        index = {name: k for k, name in enumerate(self.names)}
+
+        def on_state(message: Message, envelope: Envelope) -> None:
+            assert isinstance(message, RobotState)
+            if message.robot != me:
+                k = index[message.robot]
+                self.others[i][k] = (message.x_m, message.y_m, message.radius_m, envelope.t_recv_ns)
+
+        return on_state
+
+    def _broadcast(self, run: RunContext, now_ns: int) -> None:
+        for i, host in enumerate(self.hosts):
+            x, y, yaw = self.pose[i]
+            state = RobotState(
+                now_ns,
+                self.names[i],
+                float(x),
+                float(y),
+                float(yaw),
+                float(self.vel[i, 0]),
+                self.radius,
+            )
+            run.bus.publish(ROBOT_STATES, state, host)
+
+    def _status(self, run: RunContext, i: int, state: str, remaining: float) -> None:
+        x, y, _ = self.pose[i]
+        message = NavStatus(
+            run.kernel.now_ns, int(self.goal_id[i]), state, float(x), float(y), float(remaining)
+        )
+        run.bus.publish(self.status_topics[i], message, self.hosts[i])
+
+    # -- goals and plans ------------------------------------------------------------------
+    def _on_goal(self, run: RunContext, i: int) -> Callable[[Message, Envelope], None]:
+        def on_goal(message: Message, _envelope: Envelope) -> None:
+            assert isinstance(message, NavGoal)
+            self._accept(run, i, message)
+
+        return on_goal
+
+    def _accept(self, run: RunContext, i: int, goal: NavGoal) -> None:
+        now = run.kernel.now_ns
+        self.goal_id[i] = goal.goal_id
+        self.goal[i] = (goal.x_m, goal.y_m)
+        self.records.row(now, i, "goal", goal.x_m, goal.y_m)
+        where = goal_status(self.static, (goal.x_m, goal.y_m))
+        shortest = math.inf
+        if where is GoalStatus.OK:
+            shortest = shortest_path_length_m(self.static, self.pose[i, :2], (goal.x_m, goal.y_m))
+        if not math.isfinite(shortest):
+            detail = where.value if where is not GoalStatus.OK else "enclosed"
+            self._drop(run, i, "unreachable", detail)
+            return
+        self.active[i] = True
+        self.stuck[i] = False
+        self.best_remaining[i] = math.inf
+        self.progress_ns[i] = now
+        self.recovery.reset(i)
+        self.records.start_goal(i, now, float(self.fleet.distance_m[i]), shortest)
+        self._status(run, i, "accepted", shortest)
+        self._plan(run, i, now, replan=False)
+
+    def _drop(self, run: RunContext, i: int, state: str, detail: str = "") -> None:
+        self.active[i] = False
+        self.paths.clear(i)
+        self.records.row(
+            run.kernel.now_ns, i, state, self.goal[i, 0], self.goal[i, 1], detail=detail
+        )
+        self._status(run, i, state, math.nan)
+
+    def _obstacles_for_plan(self, i: int, now_ns: int) -> tuple[np.ndarray, np.ndarray]:
+        points = self.moving.recall(i, self.static.resolution_m)
+        points = points[~self.memory.seen_through(i, points, 2 * self.static.resolution_m)]
+        discs = self._discs(i, now_ns)
+        return points, discs
+
+    def _discs(self, i: int, now_ns: int) -> np.ndarray:
+        timeout = s_to_ns(self.cfg.robots_layer_timeout_s)
+        known = [(x, y, r) for x, y, r, t in self.others[i].values() if now_ns - t <= timeout]
+        return np.array(known, dtype=float).reshape(-1, 3)
+
+    def _plan(self, run: RunContext, i: int, now_ns: int, *, replan: bool) -> bool:
+        start = time.perf_counter()
+        points, discs = self._obstacles_for_plan(i, now_ns)
+        cost = with_obstacles(self.static, points, discs=discs if len(discs) else None)
+        s_cell = self.static.world_to_cell(self.pose[i, :2])
+        g_cell = self.static.world_to_cell(self.goal[i])
+        result = plan(cost, s_cell, g_cell, resolution_m=self.static.resolution_m)
+        detail = ""
+        if not result.found:
+            # as Nav2's "clear costmap" recovery does: plan on the static layer alone, and
+            # leave the robots and people in the way to the local controller
+            detail = "cleared"
+            cost = self.static.cost
+            result = plan(cost, s_cell, g_cell, resolution_m=self.static.resolution_m)
+        if result.found:
+            cells = prune_path(cost, result.cells)
+            waypoints = path_to_world(self.static, cells)
+            waypoints[-1] = self.goal[i]
+            self.paths.set(i, waypoints)
+            # moving things the new path bends around: replan while they may leave
+            shaped = paths_blocked(
+                self.paths,
+                np.full(len(points), i),
+                points,
+                self.radius + self.cfg.inflation_radius_m,
+                len(waypoints),
+            )
+            self.planned_around[i] = bool(shaped[i])
+        plan_ms = (time.perf_counter() - start) * 1e3
+        self.next_plan_ns[i] = now_ns + period_ns(self.cfg.replan_hz)
+        length = result.length_m if result.found else math.nan
+        self.records.row(
+            now_ns,
+            i,
+            "replan" if replan else "plan",
+            self.goal[i, 0],
+            self.goal[i, 1],
+            path_length_m=length,
+            plan_ms=plan_ms,
+            detail=detail if result.found else "no path",
+        )
+        return bool(result.found)
+
+    # -- the control tick -------------------------------------------------------------------
+    def _control(self, run: RunContext, now_ns: int) -> None:
+        # arrivals first: an arrival may hand the robot its next goal at once (the goal
+        # sender answers the status synchronously), which the rest of the tick then follows
+        self._check_arrivals(run, now_ns)
+        points, start = self.memory.near(self.near_m)
+        static = self.static
+        moving = moving_points(
+            points,
+            start,
+            self.pose,
+            static.distance_m,
+            static.origin_xy_m,
+            static.resolution_m,
+            self.traffic,
+        )
+        self.moving.remember(now_ns, moving.owner, moving.points)
+        due = self.active & (now_ns >= self.next_plan_ns)
+        if due.any():
+            # periodic replans only when the costmap changed where it matters: something
+            # moving on the path ahead now, or around the last plan (Nav2 replans at 1 Hz
+            # whatever happens; without a change the result is the same path)
+            on_path = paths_blocked(
+                self.paths, moving.owner, moving.points, self.radius + PATH_CLEARANCE_M
+            )
+            for i in np.flatnonzero(due).tolist():
+                if self.planned_around[i] or on_path[i]:
+                    self._plan(run, i, now_ns, replan=True)
+                else:
+                    self.next_plan_ns[i] = now_ns + period_ns(self.cfg.replan_hz)
+        carrots, remaining = self.paths.follow(
+            self.pose[:, 0], self.pose[:, 1], self.cfg.lookahead_m
+        )
+        carrots = keep_right(carrots, moving, self.pose, self.active, self.traffic)
+        discs, disc_start = self._all_discs(now_ns)
+        result = dwa_batch(
+            self.pose,
+            self.vel,
+            self.limits,
+            self.fleet.radius_m,
+            carrots,
+            self.goal,
+            points,
+            start,
+            discs,
+            disc_start,
+            self.dwa,
+        )
+        caps = speed_caps(
+            moving, len(self.names), self.radius, self.limits.max_speed_mps, self.traffic
+        )
+        v = np.minimum(result.v, caps)
+        v = np.where(self.active, v, 0.0)
+        w = np.where(self.active, result.w, 0.0)
+        self._track_progress(run, now_ns, remaining)
+        # halted: the controller found nothing admissible ahead, or chose to stand still
+        # (a robot in the way) while its goal is elsewhere
+        halted = result.blocked | ((np.abs(v) < HALT_MPS) & (np.abs(result.w) < HALT_RADPS))
+        self.recovery.apply(
+            now_ns,
+            halted,
+            self.active,
+            v,
+            w,
+            lambda i: self._plan(run, i, now_ns, replan=True),
+            lambda i, kind: self.records.row(
+                now_ns, i, "recovery", self.goal[i, 0], self.goal[i, 1], detail=kind
+            ),
+        )
+        publish = run.bus.publish
+        for i, (vi, wi) in enumerate(zip(v.tolist(), w.tolist(), strict=True)):
+            publish(self.cmd_topics[i], Twist(vi, wi), self.hosts[i])
+
+    def _all_discs(self, now_ns: int) -> tuple[np.ndarray, np.ndarray]:
+        n = len(self.names)
+        start = np.zeros(n + 1, dtype=np.int64)
+        if not self.cfg.robots_layer:
+            return np.zeros((0, 3)), start
+        parts = [self._discs(i, now_ns) for i in range(n)]
+        np.cumsum([len(p) for p in parts], out=start[1:])
+        return np.vstack(parts) if parts else np.zeros((0, 3)), start
+
+    def _check_arrivals(self, run: RunContext, now_ns: int) -> None:
+        gap = np.hypot(*(self.pose[:, :2] - self.goal).T)
+        for i in np.flatnonzero(self.active & (gap <= self.cfg.goal_tolerance_m)).tolist():
+            self.active[i] = False
+            self.paths.clear(i)
+            self.records.arrived(
+                now_ns, i, self.goal[i, 0], self.goal[i, 1], float(self.fleet.distance_m[i])
+            )
+            self._status(run, i, "arrived", 0.0)
+
+    def _track_progress(self, run: RunContext, now_ns: int, remaining: np.ndarray) -> None:
+        improved = self.active & (remaining < self.best_remaining - PROGRESS_M)
+        self.best_remaining[improved] = remaining[improved]
+        self.progress_ns[improved] = now_ns
+        self.stuck[improved] = False
+        timeout = s_to_ns(self.cfg.stuck_timeout_s)
+        late = self.active & ~self.stuck & (now_ns - self.progress_ns >= timeout)
+        for i in np.flatnonzero(late).tolist():
+            self.stuck[i] = True
+            self.records.row(
+                now_ns,
+                i,
+                "stuck",
+                self.goal[i, 0],
+                self.goal[i, 1],
+                detail=f"no progress for {self.cfg.stuck_timeout_s:g} s",
+            )
+            self._status(run, i, "stuck", float(remaining[i]))
+
+    def _progress(self, run: RunContext, now_ns: int) -> None:
+        _, remaining = self.paths.follow(self.pose[:, 0], self.pose[:, 1], self.cfg.lookahead_m)
+        for i in np.flatnonzero(self.active).tolist():
+            self._status(run, i, "progress", float(remaining[i]))
+
+    def finish(self, run: RunContext) -> Mapping[str, Any]:
+        """Arrivals, time to goal, path-length ratio, deadlocks, replans, recoveries."""
+        summary = self.records.summary(run.kernel.now_ns / NS_PER_S)
+        active = int(self.active.sum())
+        summary["goals_active_at_end"] = active
+        # accepted goals neither reached nor still being driven to: abandoned after `stuck`
+        accepted = summary["goals"] - summary["goals_unreachable"]
+        summary["goals_missed"] = accepted - summary["arrivals"] - active
+        return summary
+
+
+def _beam_angles(beams: int, fov_rad: float) -> np.ndarray:
+    return ScanGeometry(beams, fov_rad, 0.0, 1.0).angles()

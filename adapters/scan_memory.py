@@ -1,0 +1,148 @@
+"""What each robot's navigation remembers of its lidar: the latest scan, and moving things.
+
+:class:`ScanMemory` holds every robot's latest scan (ranges and the pose it was taken
+from): the local controller takes its nearby hits, CSR-packed for one batched call.
+:class:`MovingMemory` holds, for ``memory_s`` seconds, the hits that no static obstacle
+explains (other robots, people) within the obstacle range: the global planner marks them,
+minus those the latest scan sees through, as Nav2's obstacle layer marks and clears by
+raytracing (its default ``obstacle_max_range`` is 2.5 m; static obstacles are in the static
+layer already).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+
+import numpy as np
+import numpy.typing as npt
+
+FloatArray = npt.NDArray[np.float64]
+IntArray = npt.NDArray[np.int64]
+
+
+class ScanMemory:
+    """The latest scan of every robot.
+
+    Args:
+        robots: number of robots.
+        beam_angles: (b,) beam angles in the sensor frame (rad).
+        range_max_m: the lidar's maximum range (m).
+    """
+
+    def __init__(self, robots: int, beam_angles: FloatArray, range_max_m: float) -> None:
+        self.beams = len(beam_angles)
+        self.angles = np.asarray(beam_angles, dtype=float)
+        self.cos_a = np.cos(beam_angles)
+        self.sin_a = np.sin(beam_angles)
+        self.angle_min = float(beam_angles[0]) if self.beams else 0.0
+        self.increment = float(beam_angles[1] - beam_angles[0]) if self.beams > 1 else 1.0
+        self.range_max_m = range_max_m
+        self.ranges = np.full((robots, self.beams), np.inf, dtype=np.float32)
+        self.poses = np.zeros((robots, 3))
+        self.seen = np.zeros(robots, dtype=bool)
+
+    def add(self, robot: int, pose: FloatArray, ranges: npt.NDArray[np.float32]) -> None:
+        """Keep ``robot``'s scan taken from ``pose`` (x, y, yaw in ``map``)."""
+        self.ranges[robot] = ranges
+        self.poses[robot] = pose
+        self.seen[robot] = True
+
+    def near(self, within_m: float) -> tuple[FloatArray, IntArray]:
+        """Hits of every robot's latest scan within ``within_m`` of it, CSR-packed.
+
+        Returns:
+            ``(points, start)``: (m, 2) ``map`` points; robot ``i`` owns
+            ``points[start[i]:start[i + 1]]``; robots without a scan own none.
+        """
+        ranges = self.ranges
+        keep = np.isfinite(ranges) & (ranges > 0) & (ranges <= within_m) & self.seen[:, None]
+        r = np.where(keep, ranges, 0.0).astype(np.float64)
+        c = np.cos(self.poses[:, 2:3])
+        s = np.sin(self.poses[:, 2:3])
+        x = self.poses[:, 0:1] + r * (c * self.cos_a - s * self.sin_a)
+        y = self.poses[:, 1:2] + r * (s * self.cos_a + c * self.sin_a)
+        points = np.stack([x[keep], y[keep]], axis=1)
+        start = np.zeros(len(ranges) + 1, dtype=np.int64)
+        np.cumsum(keep.sum(axis=1), out=start[1:])
+        return points, start
+
+    def seen_through(
+        self, robot: int, points: FloatArray, tolerance_m: float
+    ) -> npt.NDArray[np.bool_]:
+        """Which points ``robot``'s latest scan sees free space beyond (by ``tolerance_m``)."""
+        if not self.seen[robot] or not len(points):
+            return np.zeros(len(points), dtype=bool)
+        x, y, yaw = self.poses[robot]
+        dx, dy = points[:, 0] - x, points[:, 1] - y
+        dist = np.hypot(dx, dy)
+        bearing = (np.arctan2(dy, dx) - yaw - self.angle_min) % (2 * math.pi)
+        beam = np.rint(bearing / self.increment).astype(np.int64)
+        inside = beam < self.beams
+        seen = self.ranges[robot, np.minimum(beam, self.beams - 1)].astype(np.float64)
+        # no return: free up to the maximum range; a return below the minimum: nothing seen
+        seen = np.where(seen == np.inf, self.range_max_m, seen)
+        seen = np.where(seen == -np.inf, 0.0, seen)
+        through: npt.NDArray[np.bool_] = inside & (dist < self.range_max_m)
+        through &= seen > dist + tolerance_m
+        return through
+
+    def local_points(self, robot: int) -> FloatArray:
+        """Hits of ``robot``'s latest scan in its ``base_link`` frame, (k, 2) (m)."""
+        ranges = self.ranges[robot].astype(np.float64)
+        hit = np.isfinite(ranges) & (ranges > 0)
+        if not self.seen[robot]:
+            return np.zeros((0, 2))
+        return np.stack([ranges[hit] * self.cos_a[hit], ranges[hit] * self.sin_a[hit]], axis=1)
+
+    def sector_min(self, robot: int, lo: float, hi: float) -> float:
+        """Smallest range (m) of ``robot``'s latest scan within beam angles [lo, hi] (rad)."""
+        if not self.seen[robot]:
+            return 0.0
+        ranges = self.ranges[robot].astype(np.float64)
+        ranges = np.where(np.isnan(ranges) | (ranges == np.inf), self.range_max_m, ranges)
+        ranges = np.where(ranges == -np.inf, 0.0, ranges)
+        sector = (self.angles >= lo) & (self.angles <= hi)
+        return float(ranges[sector].min()) if sector.any() else self.range_max_m
+
+
+class MovingMemory:
+    """Moving things (robots, people) seen by each robot in the last ``memory_ns``.
+
+    Args:
+        memory_ns: how long a sighting is kept (ns).
+    """
+
+    def __init__(self, memory_ns: int) -> None:
+        self.memory_ns = memory_ns
+        self._ticks: deque[tuple[int, IntArray, FloatArray]] = deque()
+
+    def remember(self, now_ns: int, owner: IntArray, points: FloatArray) -> None:
+        """Keep the sightings of one instant: ``points`` (k, 2) in ``map``, seen by ``owner``.
+
+        ``owner`` must be sorted (points grouped by robot), as CSR-packed scans are.
+        """
+        self._ticks.append((now_ns, owner, points))
+        while self._ticks and now_ns - self._ticks[0][0] > self.memory_ns:
+            self._ticks.popleft()
+
+    def recall(self, robot: int, cell_m: float) -> FloatArray:
+        """Everything ``robot`` saw moving within the memory, one point per ``cell_m`` cell.
+
+        Returns:
+            (m, 2) points in ``map`` (m), the first sighting of each cell of a
+            ``cell_m`` grid (marking a costmap cell twice changes nothing).
+        """
+        parts = []
+        for _, owner, points in self._ticks:
+            lo, hi = np.searchsorted(owner, (robot, robot + 1))
+            if hi > lo:
+                parts.append(points[lo:hi])
+        if not parts:
+            return np.zeros((0, 2))
+        every = np.vstack(parts)
+        cells = np.floor(every / cell_m).astype(np.int64)
+        # one integer key per cell (a 1-D unique is far cheaper than unique rows)
+        keys = (cells[:, 0] << 32) + (cells[:, 1] & 0xFFFFFFFF)
+        _, first = np.unique(keys, return_index=True)
+        return every[np.sort(first)]

@@ -1,0 +1,36 @@
+import math
+
+import numpy as np
+import pytest
+
+from adapters.scan_memory import MovingMemory, ScanMemory
+
+ANGLES = -math.pi + 2 * math.pi / 8 * np.arange(8)  # every 45 deg, beam 4 looks ahead
+
+
+def test_near_hits_are_packed_per_robot_in_map_frame():
+    memory = ScanMemory(2, ANGLES, 10.0)
+    ranges = np.full(8, np.inf, dtype=np.float32)
+    ranges[4] = 2.0  # ahead
+    memory.add(0, np.array([1.0, 1.0, math.pi / 2]), ranges)
+    points, start = memory.near(3.0)
+    assert list(start) == [0, 1, 1]
+    assert points[0] == pytest.approx([1.0, 3.0])
+
+
+def test_points_the_latest_scan_sees_through_are_cleared():
+    memory = ScanMemory(1, ANGLES, 10.0)
+    ranges = np.full(8, 5.0, dtype=np.float32)
+    memory.add(0, np.array([0.0, 0.0, 0.0]), ranges)
+    points = np.array([[2.0, 0.0], [6.0, 0.0], [0.0, -2.0]])
+    assert list(memory.seen_through(0, points, 0.2)) == [True, False, True]
+
+
+def test_moving_memory_forgets_after_its_span_and_dedups_cells():
+    memory = MovingMemory(1_000_000_000)
+    memory.remember(0, np.array([0, 1]), np.array([[1.0, 1.0], [5.0, 5.0]]))
+    memory.remember(500_000_000, np.array([0]), np.array([[1.02, 1.03]]))
+    assert len(memory.recall(0, 0.1)) == 1
+    memory.remember(1_200_000_000, np.array([1]), np.array([[6.0, 6.0]]))
+    assert len(memory.recall(0, 0.1)) == 1  # the first tick is forgotten, the second kept
+    assert memory.recall(1, 0.1) == pytest.approx(np.array([[6.0, 6.0]]))
