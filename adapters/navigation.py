@@ -1,7 +1,8 @@
 """The navigation adapter: the Nav2 role on every robot.
 
 Interface (per robot, on the robot's host): a :class:`~cosim.messages.NavGoal` on
-``/<robot>/nav/goal`` means "go to (x, y)"; the adapter answers on ``/<robot>/nav/status``
+``/<robot>/nav/goal`` means "go to (x, y)" (a goal with NaN coordinates cancels the current
+one: the robot stops, status ``cancelled``); the adapter answers on ``/<robot>/nav/status``
 with ``accepted``, periodic ``progress``, ``arrived``, ``stuck`` (no progress for
 ``navigation.stuck_timeout_s``; it keeps trying) and ``unreachable`` (outside the map,
 inside an obstacle, or enclosed on the static map; the goal is dropped).
@@ -209,6 +210,16 @@ class NavigationAdapter:
 
     def _accept(self, run: RunContext, i: int, goal: NavGoal) -> None:
         now = run.kernel.now_ns
+        if not (math.isfinite(goal.x_m) and math.isfinite(goal.y_m)):
+            # a goal without a position cancels the current one: the robot stops
+            was_active = bool(self.active[i])
+            self.goal_id[i] = goal.goal_id
+            self.active[i] = False
+            self.paths.clear(i)
+            if was_active:
+                self.records.row(now, i, "cancelled", self.goal[i, 0], self.goal[i, 1])
+            self._status(run, i, "cancelled", math.nan)
+            return
         self.goal_id[i] = goal.goal_id
         self.goal[i] = (goal.x_m, goal.y_m)
         self.records.row(now, i, "goal", goal.x_m, goal.y_m)

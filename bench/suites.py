@@ -8,6 +8,7 @@ from collections.abc import Callable
 from typing import Any, ClassVar
 
 import numpy as np
+from assignment_bench import assignment_solve_stats
 from dwa_bench import dwa_us_per_robot
 from lidar_bench import lidar_rays_per_second
 from network_bench import network_deliveries_per_second
@@ -252,8 +253,9 @@ def fleet50_navigation(repeat: int) -> Result:
     total = sum(v[2] for v in stats.values())
     shares = {}
     for label, (path, func) in BREAKDOWN.items():
-        cum = sum(v[3] for (file, _line, name), v in stats.items()
-                  if file.endswith(path) and name == func)
+        cum = sum(
+            v[3] for (file, _line, name), v in stats.items() if file.endswith(path) and name == func
+        )
         shares[label] = round(cum / total, 3) if total else None
     return {
         **runs,
@@ -277,6 +279,7 @@ SUITES: dict[str, Callable[[int], Result]] = {
     "planner": planner_ms,
     "fleet50_navigation": fleet50_navigation,
     "dwa": dwa_us_per_robot,
+    "assignment": assignment_solve_stats,
     "fleet50_physics": fleet50_physics,
     "fleet50_wander": fleet50_wander,
     "fleet1000_wander": fleet1000_wander,

@@ -14,6 +14,7 @@ from cosim.rng import RngStreams
 from cosim.scenario.model import Scenario
 
 DRIVERS: dict[str, list[str]] = {
+    "tasks": ["navigation", "task_source", "dta"],
     "navigation": ["navigation", "goals"],
     "waypoints": ["waypoints"],
     "wander": ["wander"],
@@ -29,7 +30,7 @@ def adapter_names(scenario: Scenario) -> list[str]:
             a lidar).
     """
     driver = scenario.robots.driver
-    if driver in ("wander", "navigation") and scenario.lidar.beams == 0:
+    if driver in ("wander", "navigation", "tasks") and scenario.lidar.beams == 0:
         raise ConfigError(
             f"{scenario.source}: [robots] driver = {driver!r}: expected lidar.beams > 0 "
             "(it avoids what the lidar sees)"

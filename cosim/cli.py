@@ -186,9 +186,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
             f"{s['wall_time_s']:.2f} s ({s['real_time_factor']:g}x real time), "
             f"{s['robots']} robots, {s['events']} events, {s['messages_sent']} messages"
         )
-        highlights = [
-            f"{s[key]} {label}" for key, label in HIGHLIGHTS if s.get(key) is not None
-        ]
+        highlights = [f"{s[key]} {label}" for key, label in HIGHLIGHTS if s.get(key) is not None]
         if highlights:
             print("  " + ", ".join(highlights))
         tables = ", ".join(sorted(result.tables))

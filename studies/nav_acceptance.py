@@ -43,7 +43,10 @@ KEYS = (
 
 def one(job: tuple[str, int, float]) -> dict[str, Any]:
     preset, seed, duration = job
-    scenario = cosim.load_scenario(preset, {"network.profile": "ideal", "record.messages": False})
+    scenario = cosim.load_scenario(
+        preset,
+        {"network.profile": "ideal", "robots.driver": "navigation", "record.messages": False},
+    )
     summary = cosim.run(scenario, seed=seed, duration_s=duration).summary
     return {"preset": preset, "seed": seed, **{k: summary.get(k) for k in KEYS}}
 

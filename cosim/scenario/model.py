@@ -7,12 +7,14 @@ from typing import Any, get_type_hints
 
 from cosim.scenario.network import NetworkConfig
 from cosim.scenario.sections import (
+    AssignmentConfig,
     LidarConfig,
     NavigationConfig,
     OdometryConfig,
     RecordConfig,
     RobotsConfig,
     ScenarioSection,
+    TasksConfig,
     WorldConfig,
 )
 
@@ -32,6 +34,8 @@ class Scenario:
     odometry: OdometryConfig = field(default_factory=OdometryConfig)
     network: NetworkConfig = field(default_factory=NetworkConfig)
     navigation: NavigationConfig = field(default_factory=NavigationConfig)
+    tasks: TasksConfig = field(default_factory=TasksConfig)
+    assignment: AssignmentConfig = field(default_factory=AssignmentConfig)
     record: RecordConfig = field(default_factory=RecordConfig)
     source: str = field(default="<defaults>", compare=False)
 

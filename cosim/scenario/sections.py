@@ -78,10 +78,11 @@ class RobotsConfig:
     max_yaw_accel_radps2: float = param(3.0, "yaw acceleration limit (rad/s^2)", gt=0)
     radius_m: float = param(0.33, "footprint radius (m)", gt=0)
     control_hz: float = param(20.0, "kinematics and odometry rate (Hz)", gt=0, le=1000)
-    driver: Literal["navigation", "waypoints", "wander"] = param(
+    driver: Literal["tasks", "navigation", "waypoints", "wander"] = param(
         "navigation",
-        "robot software: navigation to random reachable goals (the Nav2 role), straight-line "
-        "waypoints without avoidance, or reactive lidar wandering",
+        "robot software: dynamic task assignment over the network driving through navigation, "
+        "navigation to random reachable goals (the Nav2 role), straight-line waypoints "
+        "without avoidance, or reactive lidar wandering",
     )
 
     def problems(self) -> Iterator[Problem]:
@@ -179,3 +180,56 @@ class NavigationConfig:
         gt=0,
     )
     progress_hz: float = param(1.0, "rate of `progress` status reports (Hz)", gt=0)
+
+
+@dataclass(frozen=True)
+class TasksConfig:
+    """``[tasks]``: pick tasks at the shelves, created over time by the task source.
+
+    As in the paper, a new task appears whenever one is completed.
+    """
+
+    initial: int = param(4, "tasks open at the start", ge=1)
+    max_total: int = param(0, "tasks created over the run, 0 = unlimited", ge=0)
+    eligibility_prob: float = param(
+        1.0,
+        "probability that a robot may serve a task (ChoiRbot's example uses a subset)",
+        gt=0,
+        le=1,
+    )
+    dwell_s: float = param(2.0, "time a robot spends at a task to serve it (s)", ge=0)
+    station_offset_m: float = param(
+        0.25, "pick stations: free space between the footprint and the shelf face (m)", gt=0
+    )
+
+    def problems(self) -> Iterator[Problem]:
+        """A cap below the initial tasks would never be reached."""
+        if 0 < self.max_total < self.initial:
+            yield Problem("max_total", self.max_total, f"0 or at least initial ({self.initial})")
+
+
+@dataclass(frozen=True)
+class AssignmentConfig:
+    """``[assignment]``: how robots decide who serves which task."""
+
+    protocol: Literal["distributed_simplex", "hungarian", "greedy", "cbba"] = param(
+        "distributed_simplex",
+        "distributed simplex (Buerger et al. 2012, as in ChoiRbot), centralized Hungarian on "
+        "the base station, nearest free task, or consensus-based auction (Choi et al. 2009)",
+    )
+    period_ms: float = param(100.0, "protocol round period (ms)", gt=0)
+    preemption: bool = param(
+        False, "a robot heading to its task may be re-assigned by a later epoch"
+    )
+    diameter_bound: int = param(
+        0, "bound on the robot graph's diameter for halting; 0 = from the topology", ge=0
+    )
+    cost: Literal["euclidean", "path"] = param(
+        "euclidean", "task cost: straight-line distance, or shortest path on the static map"
+    )
+    claim_timeout_s: float = param(
+        5.0, "a claim not repeated for this long is released by the task source (s)", gt=0
+    )
+    rebroadcast_s: float = param(
+        1.0, "period of re-sending task sets, claims and unchanged protocol state (s)", gt=0
+    )

@@ -1,0 +1,297 @@
+"""The task source on the base station: tasks appear, are announced, claimed, served, closed.
+
+It opens ``tasks.initial`` tasks at pick stations (shelf faces) at the start and a new one
+whenever one is completed (as in the paper), up to ``tasks.max_total``. The open tasks
+are broadcast as a :class:`~cosim.messages.TaskSet` over the network whenever they change
+(a new *epoch*) and every ``assignment.rebroadcast_s``. It keeps the book of claims and is
+the one authority on service: a robot at a task asks for the right to serve it, and only
+one robot ever gets it (see :mod:`models.tasks.book`). With ``assignment.protocol =
+"hungarian"`` it also solves the assignment centrally from the robots' reported poses and
+sends each robot its order over the network.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from typing import Any, ClassVar
+
+import numpy as np
+from scipy import ndimage
+
+from adapters.dta_topics import (
+    CLAIMS,
+    DONE,
+    REPORTS,
+    SERVICE_REQUESTS,
+    TASKS,
+    order_topic,
+    reply_topic,
+)
+from cosim.adapter import RunContext
+from cosim.bus import Envelope
+from cosim.errors import ScenarioError
+from cosim.hosts import BASE_HOST
+from cosim.kernel import Stage
+from cosim.messages import (
+    Message,
+    RobotState,
+    ServiceReply,
+    ServiceRequest,
+    TaskClaim,
+    TaskDone,
+    TaskInfo,
+    TaskOrder,
+    TaskSet,
+)
+from cosim.timebase import NS_PER_S, period_ns, s_to_ns
+from models.assignment.problem import AssignmentProblem, hungarian
+from models.kinematics import FleetState
+from models.navigation.costmap import INSCRIBED, StaticCostmap
+from models.tasks.book import ClaimOutcome, TaskBook, TaskStatus
+from models.tasks.stations import pick_stations
+from models.world import Warehouse
+
+TASK_COLUMNS = (
+    "task",
+    "x_m",
+    "y_m",
+    "t_created_s",
+    "t_assigned_s",
+    "robot",
+    "t_started_s",
+    "t_completed_s",
+    "reassignments",
+)
+ANNOUNCE_HZ = 5.0
+"""How often the source checks whether a new epoch must be announced (Hz)."""
+
+
+class TaskSourceAdapter:
+    """Creates, announces and closes tasks; grants service; the Hungarian baseline."""
+
+    name: ClassVar[str] = "task_source"
+    requires: ClassVar[tuple[str, ...]] = ("world", "fleet", "network", "navigation")
+
+    def __init__(self, run: RunContext) -> None:
+        self.cfg = run.scenario.tasks
+        self.assignment = run.scenario.assignment
+        world = run.service(Warehouse)
+        fleet = run.service(FleetState)
+        self.robots = list(fleet.names)
+        self.stations = _reachable_stations(run, world, run.service(StaticCostmap), fleet)
+        if not len(self.stations):
+            raise ScenarioError(
+                f"{run.scenario.source}: world.shelf_count = {run.scenario.world.shelf_count}: "
+                "expected shelves with a reachable pick station (tasks are served at shelves)"
+            )
+        self.rng = run.rng.stream("tasks")
+        self.book = TaskBook(
+            self.robots, s_to_ns(self.assignment.claim_timeout_s), self.assignment.preemption
+        )
+        self.next_id = 0
+        self.epoch = 0
+        self.dirty = True
+        self.last_announce_ns = -(1 << 62)
+        self.poses: dict[str, tuple[float, float]] = {}
+        self.orders: dict[str, tuple[int, float]] = {}
+        run.provide(self)
+
+    # -- life of tasks ---------------------------------------------------------------
+    def start(self, run: RunContext) -> None:
+        """Open the first tasks and start announcing."""
+        bus = run.bus
+        bus.subscribe(CLAIMS, BASE_HOST, self._handler(run, self._on_claim))
+        bus.subscribe(SERVICE_REQUESTS, BASE_HOST, self._handler(run, self._on_request))
+        bus.subscribe(DONE, BASE_HOST, self._handler(run, self._on_done))
+        if self.assignment.protocol == "hungarian":
+            bus.subscribe(REPORTS, BASE_HOST, self._handler(run, self._on_report))
+        for _ in range(self.cfg.initial):
+            self._create(run)
+        run.kernel.every(
+            period_ns(ANNOUNCE_HZ), lambda now: self._announce(run, now), stage=Stage.CONTROL
+        )
+        run.kernel.every(s_to_ns(1.0), lambda now: self._expire(run, now), stage=Stage.CONTROL)
+
+    def _handler(
+        self, run: RunContext, fn: Callable[[RunContext, Any], None]
+    ) -> Callable[[Message, Envelope], None]:
+        def handle(message: Message, _envelope: Envelope) -> None:
+            fn(run, message)
+
+        return handle
+
+    def _create(self, run: RunContext) -> None:
+        cap = self.cfg.max_total
+        if cap and self.next_id >= cap:
+            return
+        used = {(t.x_m, t.y_m) for t in self.book.tasks.values() if t.status is not TaskStatus.DONE}
+        free = [k for k, (x, y, _) in enumerate(self.stations) if (x, y) not in used]
+        if not free:
+            return
+        x, y, _ = self.stations[free[int(self.rng.integers(len(free)))]]
+        eligible = frozenset(self._eligible())
+        task = self.book.create(self.next_id, float(x), float(y), eligible, run.kernel.now_ns)
+        self.next_id += 1
+        self.dirty = True
+        run.recorder.event(
+            run.kernel.now_ns,
+            "task_source",
+            "task",
+            f"task {task.task_id} at "
+            f"({task.x_m:.2f}, {task.y_m:.2f}), {len(eligible)} robots eligible",
+        )
+
+    def _eligible(self) -> list[str]:
+        p = self.cfg.eligibility_prob
+        while True:
+            draws = self.rng.random(len(self.robots))
+            chosen = [name for name, u in zip(self.robots, draws, strict=True) if u < p]
+            if chosen:  # a task nobody may serve would never be served
+                return chosen
+
+    def _announce(self, run: RunContext, now_ns: int) -> None:
+        due = now_ns - self.last_announce_ns >= s_to_ns(self.assignment.rebroadcast_s)
+        if not (self.dirty or due):
+            return
+        if self.dirty:
+            self.epoch += 1
+            self.dirty = False
+        if self.assignment.protocol == "hungarian":
+            # re-solved at every announcement: robot poses arrive over time
+            self._solve_centrally(run)
+        self.last_announce_ns = now_ns
+        tasks = tuple(
+            TaskInfo(
+                t.task_id,
+                t.x_m,
+                t.y_m,
+                tuple(sorted(t.eligible, key=self.robots.index)),
+                self.book.holder(t),
+            )
+            for t in self.book.offered()
+        )
+        run.bus.publish(TASKS, TaskSet(now_ns, self.epoch, tasks), BASE_HOST)
+        for robot, (task_id, cost) in self.orders.items():
+            order = TaskOrder(now_ns, self.epoch, robot, task_id, cost)
+            run.bus.publish(order_topic(robot), order, BASE_HOST)
+
+    def _expire(self, run: RunContext, now_ns: int) -> None:
+        for task_id in self.book.expire(now_ns):
+            self.dirty = True
+            run.recorder.event(now_ns, "task_source", "claim_expired", f"task {task_id}")
+
+    # -- messages from robots ----------------------------------------------------------
+    def _on_claim(self, run: RunContext, claim: TaskClaim) -> None:
+        now = run.kernel.now_ns
+        if claim.state == "release":
+            if self.book.release(claim.task_id, claim.robot):
+                self.dirty = True
+            return
+        outcome = self.book.claim(claim.task_id, claim.robot, claim.cost_m, now)
+        if outcome in (ClaimOutcome.REPLACED, ClaimOutcome.REJECTED):
+            self.dirty = True  # robots decided differently: let them solve again
+        if outcome in (ClaimOutcome.REPLACED, ClaimOutcome.REJECTED):
+            run.recorder.event(
+                now,
+                "task_source",
+                "conflict",
+                f"task {claim.task_id}: {claim.robot} {outcome.value}",
+            )
+
+    def _on_request(self, run: RunContext, request: ServiceRequest) -> None:
+        now = run.kernel.now_ns
+        granted = self.book.request_service(request.task_id, request.robot, now)
+        reply = ServiceReply(now, request.task_id, request.robot, granted)
+        run.bus.publish(reply_topic(request.robot), reply, BASE_HOST)
+
+    def _on_done(self, run: RunContext, done: TaskDone) -> None:
+        now = run.kernel.now_ns
+        # acknowledge every report (the robot repeats it until acknowledged)
+        run.bus.publish(reply_topic(done.robot), TaskDone(now, done.task_id, done.robot), BASE_HOST)
+        if self.book.done(done.task_id, done.robot, now):
+            run.recorder.event(now, "task_source", "done", f"task {done.task_id} by {done.robot}")
+            self.dirty = True
+            self._create(run)
+
+    def _on_report(self, run: RunContext, state: RobotState) -> None:
+        self.poses[state.robot] = (state.x_m, state.y_m)
+
+    # -- the centralized baseline -----------------------------------------------------------
+    def _solve_centrally(self, run: RunContext) -> None:
+        """Hungarian optimum over the robots whose pose the base knows and are free."""
+        held = {t.task_id: self.book.holder(t) for t in self.book.offered()}
+        tasks = [t for t in self.book.offered() if not held[t.task_id]]
+        busy = {holder for holder in held.values() if holder}
+        robots = [r for r in self.robots if r in self.poses and r not in busy]
+        self.orders = {r: order for r, order in self.orders.items() if r in busy}
+        if not robots or not tasks:
+            return
+        cost = np.full((len(robots), len(tasks)), np.inf)
+        for i, robot in enumerate(robots):
+            x, y = self.poses[robot]
+            for j, task in enumerate(tasks):
+                if robot in task.eligible:
+                    cost[i, j] = float(np.hypot(task.x_m - x, task.y_m - y))
+        problem = AssignmentProblem(tuple(robots), tuple(t.task_id for t in tasks), cost)
+        assignment, _ = hungarian(problem)
+        for i, robot in enumerate(robots):
+            chosen = assignment.get(i)
+            self.orders[robot] = (
+                (tasks[chosen].task_id, float(cost[i, chosen])) if chosen is not None else (-1, 0.0)
+            )
+
+    # -- records ---------------------------------------------------------------------------
+    def finish(self, run: RunContext) -> Mapping[str, Any]:
+        """The tasks table and the task metrics."""
+        table = run.recorder.table("tasks", TASK_COLUMNS, categorical=("robot",))
+        completed = []
+        for task in sorted(self.book.tasks.values(), key=lambda t: t.task_id):
+            table.append(
+                task=task.task_id,
+                x_m=task.x_m,
+                y_m=task.y_m,
+                t_created_s=_s(task.created_ns),
+                t_assigned_s=_s(task.assigned_ns),
+                robot=task.server or "",
+                t_started_s=_s(task.started_ns),
+                t_completed_s=_s(task.completed_ns),
+                reassignments=task.reassignments,
+            )
+            if task.status is TaskStatus.DONE:
+                completed.append((task.completed_ns - task.created_ns) / NS_PER_S)
+        minutes = run.kernel.now_ns / NS_PER_S / 60.0
+        return {
+            "tasks_created": len(self.book.tasks),
+            "tasks_completed": len(completed),
+            "tasks_per_min": round(len(completed) / minutes, 6) if minutes > 0 else None,
+            "mean_task_latency_s": round(float(np.mean(completed)), 6) if completed else None,
+            "conflicts": self.book.conflicts,
+            "services_refused": self.book.refused_services,
+            "epochs": self.epoch,
+        }
+
+
+def _s(t_ns: int) -> float:
+    return t_ns / NS_PER_S if t_ns >= 0 else float("nan")
+
+
+def _reachable_stations(
+    run: RunContext, world: Warehouse, static: StaticCostmap, fleet: FleetState
+) -> np.ndarray:
+    """Pick stations where a robot can stand and that the fleet can reach."""
+    radius = run.scenario.robots.radius_m
+    stations = pick_stations(
+        world.shelves,
+        radius,
+        run.scenario.tasks.station_offset_m,
+        lambda points: world.is_free(points, radius),
+    )
+    labels, _ = ndimage.label(static.cost < INSCRIBED, structure=np.ones((3, 3)))
+    regions = {
+        labels[static.world_to_cell((x, y))[::-1]] for x, y in zip(fleet.x, fleet.y, strict=True)
+    }
+    keep = []
+    for x, y, _ in stations:
+        cell = static.world_to_cell((x, y))
+        keep.append(static.in_bounds(cell) and labels[cell[1], cell[0]] in regions - {0})
+    return stations[np.array(keep, dtype=bool)] if len(stations) else stations

@@ -1,0 +1,284 @@
+"""The distributed simplex of Bürger, Notarstefano, Bullo and Allgöwer (Automatica, 2012).
+
+Each agent owns some columns of the assignment LP (its robots' pair and idle columns) and
+knows every big-M "unserved" column. It keeps one basis, starting from the identity basis.
+In a round it receives its neighbours' bases, solves the LP restricted to its own columns,
+its basis and the received bases with the lexicographic simplex
+(:mod:`models.assignment.simplex`), and keeps the lexicographically optimal basis. The
+lexicographic objective never increases along a round and the optimum of a column set is
+unique, so the agents' bases converge in finite time to the one optimal basis of the whole
+LP; an agent halts once its basis has not changed for ``2 * diameter_bound + 1``
+consecutive rounds, which by the paper's Theorem (the stopping rule) means every agent
+holds the optimal basis.
+
+:class:`SimplexAgent` is the per-agent state machine (no time, no messages: the caller
+moves bases between agents, tagged with :attr:`SimplexAgent.epoch`, and drops bases of
+another epoch). :func:`run_synchronous` runs agents in lock step over a fixed graph, for
+tests and benchmarks.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from collections.abc import Iterable, Sequence
+from itertools import chain
+from typing import NamedTuple
+
+import numpy as np
+
+from models.assignment.problem import (
+    AssignmentProblem,
+    Column,
+    ColumnKind,
+    LpShape,
+    identity_basis,
+    unserved_columns,
+)
+from models.assignment.simplex import lex_simplex
+from models.errors import ModelError
+
+
+class SimplexAgent:
+    """One agent of the distributed simplex.
+
+    Args:
+        shape: the LP's rows (numbers of robots and tasks), known to every agent.
+        own_columns: the columns this agent owns (pairs and idle columns of its robots).
+        diameter_bound: an upper bound on the communication graph's diameter (hops, >= 0).
+        epoch: the task-set version this agent solves; bases of another epoch must not be
+            handed to :meth:`merge_and_solve`.
+        unserved_cost: the big-M cost of the unserved columns.
+
+    Attributes:
+        rounds: rounds run so far.
+        unchanged: consecutive rounds, up to the last, in which the basis did not change.
+        pivots: pivots of the last round's solve.
+        solved: whether the last round ran the simplex; it is skipped when every
+            candidate column was already a candidate of the last solve (the basis, optimal
+            over that set, is optimal over any subset of it that holds it).
+
+    Raises:
+        ModelError: ``assignment.diameter_bound`` when negative.
+    """
+
+    def __init__(
+        self,
+        shape: LpShape,
+        own_columns: Iterable[Column],
+        diameter_bound: int,
+        epoch: int,
+        *,
+        unserved_cost: float,
+    ) -> None:
+        if diameter_bound < 0:
+            raise ModelError("assignment.diameter_bound", diameter_bound, "a hop count >= 0")
+        self.shape = shape
+        self.diameter_bound = diameter_bound
+        self.epoch = epoch
+        self._known = tuple(sorted(set(own_columns).union(unserved_columns(shape, unserved_cost))))
+        self._basis = identity_basis(shape, unserved_cost)
+        self._inverse = np.eye(shape.rows)
+        self._candidates: dict[Column, None] = {}
+        self.solved = False
+        self.rounds = 0
+        self.unchanged = 0
+        self.pivots = 0
+
+    @property
+    def own_columns(self) -> tuple[Column, ...]:
+        """The columns this agent always keeps: its own and the unserved ones, in key order."""
+        return self._known
+
+    @property
+    def basis(self) -> list[Column]:
+        """The current basis, m columns in key order (a copy); first the identity basis."""
+        return list(self._basis)
+
+    @property
+    def converged(self) -> bool:
+        """Halted: the basis has not changed for ``2 * diameter_bound + 1`` rounds."""
+        return self.unchanged >= 2 * self.diameter_bound + 1
+
+    def merge_and_solve(self, received: Sequence[Sequence[Column]]) -> bool:
+        """One round: solve over own columns, own basis and the received bases.
+
+        Received bases overlap; columns are merged by key (one key with two costs is an
+        error). Calling this after :attr:`converged` is harmless: the basis stays.
+
+        Args:
+            received: the neighbours' bases of this epoch, each m columns.
+
+        Returns:
+            Whether the basis changed.
+
+        Raises:
+            ModelError: ``received`` when a basis does not have m columns; see also
+                :func:`models.assignment.simplex.lex_simplex`.
+        """
+        m = self.shape.rows
+        for basis in received:
+            if len(basis) != m:
+                raise ModelError("received", len(basis), f"bases of {m} columns")
+        columns = dict.fromkeys(chain(self._known, self._basis, *received))
+        self.rounds += 1
+        # The basis is lexicographically optimal over the last candidate set, which held
+        # it; over a subset that still holds it, it stays optimal: no need to solve.
+        self.solved = not columns.keys() <= self._candidates.keys()
+        if not self.solved:
+            self.pivots = 0
+            self.unchanged += 1
+            return False
+        self._candidates = columns
+        solution = lex_simplex(self.shape, columns, self._basis, start_inverse=self._inverse)
+        changed = solution.basis != self._basis
+        self._basis = solution.basis
+        self._inverse = solution.inverse
+        self.pivots = solution.pivots
+        self.unchanged = 0 if changed else self.unchanged + 1
+        return changed
+
+    def assignment(self) -> dict[int, int]:
+        """Robot index -> task index of the current basis (pair columns at value 1)."""
+        return {c.robot: c.task for c in self._at_one() if c.kind is ColumnKind.PAIR}
+
+    def objective(self) -> float:
+        """The LP objective of the current basis: the exact sum of the costs at value 1.
+
+        A basis also holds degenerate columns at value 0 (an unserved column among them
+        would add a big-M), so summing the costs of all basic columns is wrong.
+        """
+        return math.fsum(c.cost for c in self._at_one())
+
+    def _at_one(self) -> list[Column]:
+        """The basic columns at value 1 (``x_B = B^-1 1``, integral), in key order."""
+        values = self._inverse.sum(axis=1).tolist()
+        return [c for c, v in zip(self._basis, values, strict=True) if v > 0.5]
+
+
+def agent_for(
+    problem: AssignmentProblem, robots: Iterable[int], diameter_bound: int, epoch: int = 0
+) -> SimplexAgent:
+    """The agent that owns the columns of ``robots`` (robot indices) in ``problem``."""
+    own = [c for i in sorted(set(robots)) for c in problem.columns_of(i)]
+    return SimplexAgent(
+        problem.shape, own, diameter_bound, epoch, unserved_cost=problem.unserved_cost
+    )
+
+
+class SyncResult(NamedTuple):
+    """The outcome of :func:`run_synchronous`.
+
+    Attributes:
+        rounds: rounds until every agent had halted.
+        bases: each agent's final basis (key order), by agent index.
+        assignment: robot index -> task index read from agent 0's final basis.
+        halted_at: the round in which each agent halted.
+        last_change: the last round in which some agent's basis changed (0 if none).
+        max_pivots: the most pivots one agent needed in one round.
+    """
+
+    rounds: int
+    bases: tuple[tuple[Column, ...], ...]
+    assignment: dict[int, int]
+    halted_at: tuple[int, ...]
+    last_change: int
+    max_pivots: int
+
+
+def run_synchronous(
+    problem: AssignmentProblem,
+    owner: Sequence[int],
+    edges: Iterable[tuple[int, int]],
+    diameter_bound: int | None = None,
+    *,
+    max_rounds: int = 10_000,
+) -> SyncResult:
+    """Run the distributed simplex in lock step until every agent has halted.
+
+    In round t every agent that has not halted receives its neighbours' bases of round
+    t - 1 (halted agents keep sending theirs) and solves.
+
+    Args:
+        problem: the LP.
+        owner: ``owner[i]`` is the agent index owning robot i; agents are 0..max(owner).
+        edges: undirected links between agent indices.
+        diameter_bound: the agents' diameter bound; default the graph's diameter.
+        max_rounds: a guard against a bug: exceeding it raises.
+
+    Raises:
+        ModelError: ``assignment.owner`` (wrong length or negative), ``network.edges``
+            (unknown agent, self-loop, disconnected graph), ``assignment.diameter_bound``
+            (below the diameter).
+        RuntimeError: not all agents halted within ``max_rounds``.
+    """
+    if len(owner) != len(problem.robots) or min(owner, default=0) < 0:
+        raise ModelError("assignment.owner", list(owner), "one agent index >= 0 per robot")
+    n_agents = max(owner) + 1
+    adjacent = _adjacency(n_agents, edges)
+    hops = graph_diameter(adjacent)
+    bound = hops if diameter_bound is None else diameter_bound
+    if bound < hops:
+        raise ModelError("assignment.diameter_bound", bound, f">= the diameter {hops}")
+    agents = [
+        agent_for(problem, [i for i, o in enumerate(owner) if o == a], bound)
+        for a in range(n_agents)
+    ]
+    halted_at = [0] * n_agents
+    last_change = 0
+    max_pivots = 0
+    rounds = 0
+    while not all(a.converged for a in agents):
+        if rounds >= max_rounds:
+            raise RuntimeError(f"distributed simplex did not halt in {max_rounds} rounds")
+        rounds += 1
+        sent = [a.basis for a in agents]
+        for k, agent in enumerate(agents):
+            if agent.converged:
+                continue
+            if agent.merge_and_solve([sent[j] for j in adjacent[k]]):
+                last_change = rounds
+            max_pivots = max(max_pivots, agent.pivots)
+            if agent.converged:
+                halted_at[k] = rounds
+    return SyncResult(
+        rounds=rounds,
+        bases=tuple(tuple(a.basis) for a in agents),
+        assignment=agents[0].assignment(),
+        halted_at=tuple(halted_at),
+        last_change=last_change,
+        max_pivots=max_pivots,
+    )
+
+
+def graph_diameter(adjacent: Sequence[Sequence[int]]) -> int:
+    """The largest hop count between two agents (BFS from each).
+
+    Raises:
+        ModelError: ``network.edges`` when the graph is not connected.
+    """
+    longest = 0
+    for start in range(len(adjacent)):
+        hops = {start: 0}
+        frontier = deque([start])
+        while frontier:
+            here = frontier.popleft()
+            for there in adjacent[here]:
+                if there not in hops:
+                    hops[there] = hops[here] + 1
+                    frontier.append(there)
+        if len(hops) < len(adjacent):
+            raise ModelError("network.edges", "disconnected", "a connected graph of agents")
+        longest = max(longest, max(hops.values()))
+    return longest
+
+
+def _adjacency(n_agents: int, edges: Iterable[tuple[int, int]]) -> list[list[int]]:
+    """Sorted neighbour lists; each edge must join two different known agents."""
+    adjacent: list[set[int]] = [set() for _ in range(n_agents)]
+    for a, b in edges:
+        if a == b or not (0 <= a < n_agents and 0 <= b < n_agents):
+            raise ModelError("network.edges", (a, b), f"pairs of distinct agents 0..{n_agents - 1}")
+        adjacent[a].add(b)
+        adjacent[b].add(a)
+    return [sorted(s) for s in adjacent]

@@ -1,0 +1,155 @@
+from __future__ import annotations
+
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+from models.assignment.pivoting import _exact_sign_py
+from models.assignment.problem import (
+    AssignmentProblem,
+    Column,
+    LpShape,
+    hungarian,
+    idle,
+    objective,
+    pair,
+    unserved,
+)
+from models.assignment.simplex import assignment_of, lex_simplex, primal, solve
+from models.errors import ModelError
+
+
+def _subset_basis(problem: AssignmentProblem, rng: np.random.Generator) -> list[Column]:
+    """A lexicographically feasible basis other than the identity: optimal on a subset."""
+    kept = [c for c in problem.columns() if rng.random() < 0.5]
+    return solve(problem.shape, kept, problem.start_basis())
+
+
+def test_solve_from_different_start_bases_ends_in_the_same_basis(make_lp):
+    for seed in range(200):
+        problem = make_lp(seed)
+        rng = np.random.default_rng(seed)
+        columns = problem.columns()
+        reference = solve(problem.shape, columns, problem.start_basis())
+        for _ in range(3):
+            start = _subset_basis(problem, rng)
+            shuffled = [columns[k] for k in rng.permutation(len(columns))]
+            assert solve(problem.shape, shuffled, start) == reference, f"seed {seed}"
+        again = lex_simplex(problem.shape, columns, reference)
+        assert again.basis == reference and again.pivots == 0, f"seed {seed}"
+
+
+def test_the_lexicographic_optimum_has_the_hungarian_objective_exactly(make_lp):
+    for seed in range(200, 400):
+        problem = make_lp(seed)
+        basis = solve(problem.shape, problem.columns(), problem.start_basis())
+        found = objective(problem, assignment_of(problem.shape, basis))
+        assert found == hungarian(problem)[1], f"seed {seed}"
+
+
+def test_the_returned_inverse_is_the_inverse_of_the_returned_basis(make_lp):
+    for seed in range(20):
+        problem = make_lp(seed)
+        solution = lex_simplex(problem.shape, problem.columns(), problem.start_basis())
+        m, r = problem.shape.rows, problem.shape.n_robots
+        matrix = np.zeros((m, m))
+        for k, column in enumerate(solution.basis):
+            matrix[list(column.rows(r)), k] = 1.0
+        assert np.array_equal(solution.inverse @ matrix, np.eye(m))
+        assert set(np.unique(solution.inverse)) <= {-1.0, 0.0, 1.0}
+
+
+def test_basic_values_are_zero_or_one_and_the_assignment_is_a_matching(make_lp):
+    for seed in range(50):
+        problem = make_lp(seed)
+        basis = solve(problem.shape, problem.columns(), problem.start_basis())
+        assert set(primal(problem.shape, basis).tolist()) <= {0.0, 1.0}
+        assignment = assignment_of(problem.shape, basis)
+        assert len(set(assignment.values())) == len(assignment)
+
+
+@pytest.mark.parametrize("value", [0.0, 1.0, 0.1])
+def test_fully_degenerate_instances_end_without_hitting_the_pivot_cap(value):
+    # all costs equal, every pair eligible: every matching ties, most pivots are degenerate
+    for n_robots, n_tasks in [(15, 15), (15, 7), (7, 15)]:
+        cost = np.full((n_robots, n_tasks), value)
+        problem = AssignmentProblem(
+            tuple(f"r{i}" for i in range(n_robots)), tuple(range(n_tasks)), cost
+        )
+        m, n = problem.shape.rows, len(problem.columns())
+        solution = lex_simplex(problem.shape, problem.columns(), problem.start_basis())
+        assert solution.pivots <= 20 * (m + n) + 100
+        assert len(assignment_of(problem.shape, solution.basis)) == min(n_robots, n_tasks)
+
+
+def test_the_pivot_cap_raises_when_it_is_hit():
+    problem = AssignmentProblem(("a",), (1,), np.array([[1.0]]))
+    with pytest.raises(RuntimeError, match="cap"):
+        lex_simplex(problem.shape, problem.columns(), problem.start_basis(), max_pivots=0)
+
+
+def test_exact_sign_matches_rational_arithmetic_on_cancelling_float_sums():
+    rng = np.random.default_rng(5)
+    for _ in range(500):
+        m = int(rng.integers(1, 12))
+        w = rng.integers(-1, 2, m).astype(float)
+        basic = rng.choice([0.1, 0.2, 0.3, 1e6, 1e-9, 3.0, 2.0**-60], m) * rng.choice([1, 3], m)
+        cost_j = float(np.dot(w, basic)) if rng.random() < 0.5 else float(rng.choice(basic))
+        table = np.zeros((m, 2))
+        table[:, 0] = w
+        exact = Fraction(cost_j) - sum(Fraction(b) * int(x) for b, x in zip(basic, w, strict=True))
+        expected = (exact > 0) - (exact < 0)
+        assert _exact_sign_py(table, 0, 1, cost_j, basic) == expected
+
+
+SHAPE = LpShape(2, 2)
+
+
+def test_a_singular_start_basis_is_rejected():
+    cycle = [pair(0, 0, 1.0), pair(0, 1, 1.0), pair(1, 0, 1.0), pair(1, 1, 1.0)]
+    with pytest.raises(ModelError, match="independent"):
+        solve(SHAPE, [], cycle)
+
+
+def test_a_start_basis_that_is_not_lexicographically_feasible_is_rejected():
+    infeasible = [pair(0, 0, 1.0), pair(1, 0, 1.0), unserved(0, 9.0)]
+    with pytest.raises(ModelError, match="lexicographically feasible"):
+        solve(LpShape(2, 1), [], infeasible)
+
+
+def test_a_start_basis_of_the_wrong_size_is_rejected():
+    with pytest.raises(ModelError, match="distinct columns"):
+        solve(SHAPE, [], [idle(0), idle(1), unserved(0, 9.0)])
+
+
+def test_one_column_key_with_two_costs_is_rejected():
+    start = [idle(0), idle(1), unserved(0, 9.0), unserved(1, 9.0)]
+    with pytest.raises(ModelError, match="one cost per column key"):
+        solve(SHAPE, [pair(0, 0, 1.0), pair(0, 0, 2.0)], start)
+
+
+def test_a_column_outside_the_shape_is_rejected():
+    start = [idle(0), idle(1), unserved(0, 9.0), unserved(1, 9.0)]
+    with pytest.raises(ModelError, match="indices within"):
+        solve(SHAPE, [pair(2, 0, 1.0)], start)
+
+
+def test_a_wrong_start_inverse_is_rejected():
+    start = [idle(0), idle(1), unserved(0, 9.0), unserved(1, 9.0)]
+    with pytest.raises(ModelError) as raised:
+        lex_simplex(SHAPE, [], start, start_inverse=2.0 * np.eye(4))
+    assert raised.value.key == "start_inverse"
+
+
+@pytest.mark.parametrize("flip", [False, True])
+def test_matchings_that_differ_below_the_rounding_error_are_still_ranked_exactly(flip):
+    # 0.1 + 0.2 exceeds 0.3 + 0.0 by 2.8e-17 in exact binary arithmetic, far inside the
+    # float error bound (big-M costs are in the basis): only the exact sign can tell.
+    cost = np.array([[0.1, 0.3], [0.0, 0.2]])
+    cost = cost[::-1] if flip else cost
+    problem = AssignmentProblem(("a", "b"), (1, 2), cost)
+    basis = solve(problem.shape, problem.columns(), problem.start_basis())
+    better = {0: 0, 1: 1} if flip else {0: 1, 1: 0}
+    assert assignment_of(problem.shape, basis) == better
+    assert objective(problem, better) == 0.3 < objective(problem, {0: 1 - better[0], 1: better[0]})
