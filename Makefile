@@ -6,7 +6,11 @@ STAMP  := $(VENV)/.installed
 SCENARIO ?= warehouse-random
 OUT    ?= runs/demo
 
-.PHONY: setup demo test lint bench clean help
+STUDIES := runs/studies
+STUDY = $(BIN)/cosim study studies/$(1).toml --out $(STUDIES)/$(1) --resume
+
+.PHONY: setup demo test lint bench clean help reproduce study-comm study-comm-reduced \
+	study-burst study-scale study-paper study-nav
 
 help:  ## list the targets
 	@grep -E '^[a-z-]+:.*##' $(MAKEFILE_LIST) | sed 's/:.*## /\t/'
@@ -32,6 +36,29 @@ lint: setup  ## ruff and mypy --strict
 
 bench: setup  ## benchmarks -> bench/results.json
 	$(BIN)/python bench/run.py --out bench/results.json
+
+reproduce: setup  ## the paper's Scenario 1 and a reduced comm sweep (about 5 min on 2 cores)
+	$(call STUDY,paper)
+	$(call STUDY,comm_sweep_reduced)
+	@echo "reports: $(STUDIES)/paper/report.md $(STUDIES)/comm_sweep_reduced/report.md"
+
+study-comm: setup  ## the full comm sweep: 1,080 runs (about 30 min on 2 cores)
+	$(call STUDY,comm_sweep)
+
+study-comm-reduced: setup  ## the comm sweep reduced to 81 runs
+	$(call STUDY,comm_sweep_reduced)
+
+study-burst: setup  ## Gilbert-Elliott vs Bernoulli loss at equal mean loss
+	$(call STUDY,burst_vs_iid)
+
+study-scale: setup  ## 4 to 200 robots: wall time, real-time factor, messages
+	$(call STUDY,scale)
+
+study-paper: setup  ## the paper's Scenario 1, random shelves and racks
+	$(call STUDY,paper)
+
+study-nav: setup  ## navigation acceptance: 3 presets x 10 seeds x 300 s
+	$(BIN)/python studies/nav_acceptance.py --seeds 10 --duration-s 300 --workers 2
 
 clean:  ## remove the virtual environment, caches and run outputs
 	rm -rf $(VENV) runs .pytest_cache .mypy_cache .ruff_cache build *.egg-info

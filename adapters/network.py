@@ -175,7 +175,11 @@ class NetworkAdapter:
     def finish(self, run: RunContext) -> Mapping[str, Any]:
         """Latency percentiles (ms) of delivered inter-host messages, and link changes."""
         latencies = np.frombuffer(self.link.latencies_ns, dtype=np.int64) / 1e6
-        summary: dict[str, Any] = {"link_changes": self.changes}
+        summary: dict[str, Any] = {
+            "link_changes": self.changes,
+            # the long-run loss of each link's loss process as configured (not measured)
+            "loss_rate_configured": round(self.model.params.loss_factory().stationary_loss(), 6),
+        }
         for q in (50, 95, 99):
             # null (not NaN, which is not JSON) when nothing crossed the network
             value = round(float(np.percentile(latencies, q)), 6) if len(latencies) else None

@@ -265,6 +265,54 @@ def fleet50_navigation(repeat: int) -> Result:
     }
 
 
+STUDY_TEXT = """
+[study]
+name = "bench_study"
+scenario = "warehouse-random"
+seeds = 4
+duration_s = 180
+
+[grid]
+"network.latency_ms" = [0, 50]
+"assignment.protocol" = ["distributed_simplex", "cbba"]
+
+[overrides]
+"record.messages" = false
+"""
+
+
+def study_throughput(repeat: int) -> Result:
+    """Runs per minute of a 16-run study (180 s each) on 1 and 2 local workers, and the speed-up."""
+    import shutil
+    import tempfile
+    from pathlib import Path
+
+    from cosim.studies import load_study, run_study
+
+    rates: dict[int, list[float]] = {1: [], 2: []}
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "study.toml"
+        path.write_text(STUDY_TEXT)
+        spec = load_study(path)
+        for _ in range(max(1, repeat - 1)):
+            for workers in (1, 2):
+                out = Path(tmp) / f"out{workers}"
+                shutil.rmtree(out, ignore_errors=True)
+                start = time.perf_counter()
+                run_study(spec, out, workers=workers, report=False)
+                rates[workers].append(len(spec.runs()) / (time.perf_counter() - start) * 60)
+    one, two = statistics.median(rates[1]), statistics.median(rates[2])
+    return {
+        "runs": 16,
+        "sim_time_s_per_run": 180,
+        "runs_per_min_1_worker": round(one, 2),
+        "runs_per_min_2_workers": round(two, 2),
+        "speedup_2_workers": round(two / one, 3),
+        "target_speedup": 1.8,
+        "note": "2 workers are spawned processes (start-up included); 1 worker runs in-process",
+    }
+
+
 def lidar(repeat: int) -> Result:
     """Grid ray caster throughput, one core (see bench/lidar_bench.py)."""
     return lidar_rays_per_second(max(repeat, 20))
@@ -280,6 +328,7 @@ SUITES: dict[str, Callable[[int], Result]] = {
     "fleet50_navigation": fleet50_navigation,
     "dwa": dwa_us_per_robot,
     "assignment": assignment_solve_stats,
+    "study": study_throughput,
     "fleet50_physics": fleet50_physics,
     "fleet50_wander": fleet50_wander,
     "fleet1000_wander": fleet1000_wander,

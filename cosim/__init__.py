@@ -8,6 +8,11 @@ The Python API for notebooks and study scripts::
     result.summary["real_time_factor"], result.tables["poses"].head()
 """
 
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
 from cosim.errors import (
     BridgeError,
     ConfigError,
@@ -18,6 +23,33 @@ from cosim.errors import (
 )
 from cosim.runner import RunResult, run
 from cosim.scenario import Scenario, load_scenario
+
+
+def study(
+    path: str | Path,
+    out: str | Path,
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    resume: bool = False,
+    **options: Any,
+) -> pd.DataFrame:
+    """Run a study file and return its results, one row per run.
+
+    Args:
+        path: the study TOML file.
+        out: the study folder.
+        workers: local processes (default: the machine's cores).
+        scheduler: a Dask scheduler address to run on instead (``tcp://host:port``).
+        resume: continue a study in ``out``.
+        **options: passed to :func:`cosim.studies.run_study` (``progress``, ``report``).
+    """
+    from cosim.studies import load_study, run_study
+
+    return run_study(
+        load_study(path), out, workers=workers, scheduler=scheduler, resume=resume, **options
+    )
+
 
 __all__ = [
     "BridgeError",
@@ -30,4 +62,5 @@ __all__ = [
     "ScenarioError",
     "load_scenario",
     "run",
+    "study",
 ]

@@ -55,6 +55,13 @@ def _non_negative_int(text: str) -> int:
     return value
 
 
+def _positive_int(text: str) -> int:
+    value = _non_negative_int(text)
+    if value == 0:
+        raise argparse.ArgumentTypeError("0 is not an integer >= 1")
+    return value
+
+
 def _positive_float(text: str) -> float:
     try:
         value = float(text)
@@ -137,6 +144,29 @@ def build_parser() -> argparse.ArgumentParser:
     world.add_argument("--sdf", type=Path, metavar="F.sdf", help="write a Gazebo SDF world")
     world.add_argument(
         "--resolution-m", type=_positive_float, default=0.05, help="map resolution (m/cell)"
+    )
+
+    study = commands.add_parser(
+        "study",
+        help="run a study: a scenario swept over overrides and seeds",
+        description=(
+            "Run every combination of a study file's [grid] (and [[cases]]) for every seed, on "
+            "local processes or a Dask cluster, and write DIR/results.parquet (one row per run), "
+            "DIR/runs/<run_id>/, and figures and report.md when the study has a [report]."
+        ),
+    )
+    study.add_argument("study", metavar="STUDY.toml", type=Path, help="the study file")
+    study.add_argument("--out", type=Path, help="study folder (default: runs/studies/NAME)")
+    study.add_argument("--workers", type=_positive_int, help="local processes (default: cores)")
+    study.add_argument(
+        "--scheduler",
+        metavar="tcp://HOST:PORT",
+        help="run on this Dask scheduler instead of local processes",
+    )
+    study.add_argument(
+        "--resume",
+        action="store_true",
+        help="continue a study in --out: skip finished runs, retry failed ones",
     )
 
     commands.add_parser(
@@ -227,6 +257,34 @@ def _cmd_world(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _cmd_study(args: argparse.Namespace) -> int:
+    from cosim.studies.runner import Progress, run_study
+    from cosim.studies.spec import load_study
+
+    spec = load_study(args.study)
+    out = args.out or Path("runs") / "studies" / spec.name
+    total = len(spec.runs())
+    where = f"Dask at {args.scheduler}" if args.scheduler else f"{args.workers or 'all'} workers"
+    print(
+        f"{spec.name}: {total} runs ({len(spec.combinations())} combinations x "
+        f"{len(spec.seeds)} seeds) on {where} -> {out}/"
+    )
+    results = run_study(
+        spec,
+        out,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        resume=args.resume,
+        progress=Progress(total, args.workers or 1),
+    )
+    failed = int((results["status"] != "ok").sum()) if len(results) else 0
+    print(
+        f"results: {out}/results.parquet ({len(results)} runs, {failed} failed)"
+        + (f", report: {out}/report.md" if (out / "report.md").exists() else "")
+    )
+    return EXIT_OK
+
+
 def _cmd_scenarios(_args: argparse.Namespace) -> int:
     names = preset_names()
     width = max(len(n) for n in names)
@@ -239,6 +297,7 @@ COMMANDS = {
     "run": _cmd_run,
     "check": _cmd_check,
     "world": _cmd_world,
+    "study": _cmd_study,
     "scenarios": _cmd_scenarios,
 }
 

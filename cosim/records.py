@@ -134,6 +134,8 @@ class Recorder:
         self.tables: dict[str, Table] = {}
         self.volatile: dict[str, tuple[str, ...]] = {}
         self.counts: dict[str, int] = {status.value: 0 for status in DeliveryStatus}
+        self.network_messages = 0
+        self.network_bytes = 0
 
     # -- the bus tap ---------------------------------------------------------------
     def on_transfer(
@@ -148,6 +150,9 @@ class Recorder:
     ) -> None:
         """Record one message towards one destination host (see :class:`cosim.bus.BusTap`)."""
         self.counts[status] += 1
+        if src != dst:
+            self.network_messages += 1
+            self.network_bytes += nbytes
         if not self.record_messages:
             return
         pending = self._pending

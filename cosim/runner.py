@@ -103,6 +103,8 @@ def execute(
         "messages_sent": sent,
         "messages_delivered": counts["delivered"],
         "messages_dropped": sent - counts["delivered"],
+        "network_messages": run.recorder.network_messages,
+        "network_bytes": run.recorder.network_bytes,
     }
     for name, adapter in assembly.adapters:
         try:

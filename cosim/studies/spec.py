@@ -1,0 +1,249 @@
+"""Study files: what to sweep, validated before anything runs.
+
+```toml
+[study]
+name = "comm_sweep"
+scenario = "warehouse-random"     # a preset, or a path relative to the study file
+seeds = 10                        # a count (seeds 1..N) or a list
+duration_s = 300                  # optional: overrides scenario.duration_s
+tables = false                    # keep each run's tables: false, true, or a list of names
+description = "..."               # optional, for the report
+
+[grid]                            # every combination of these lists, for every seed
+"network.latency_ms" = [0, 5, 20]
+
+[overrides]                       # the same for every run
+"network.loss_model" = "bernoulli"
+
+[[cases]]                         # optional: explicit combinations, crossed with the grid
+"network.loss_model" = "bernoulli"
+"network.loss_prob" = 0.1
+
+[report]                          # optional: figures and report.md
+x = "network.latency_ms"
+hue = "assignment.protocol"
+facet = "network.loss_prob"
+metrics = ["tasks_per_min", "optimality_gap"]
+```
+
+Every combination is loaded as a scenario before the study starts, so a bad key or value in
+any of them is reported (file, key, value, expectation) and nothing runs.
+"""
+
+from __future__ import annotations
+
+import itertools
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from cosim.errors import ConfigError
+from cosim.scenario import load_scenario
+from cosim.scenario.fields import suggest
+from cosim.scenario.loader import preset_names
+
+SECTIONS = ("study", "grid", "overrides", "cases", "report")
+STUDY_KEYS = ("name", "scenario", "seeds", "duration_s", "tables", "description")
+REPORT_KEYS = ("x", "hue", "facet", "metrics")
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """One run of a study.
+
+    Attributes:
+        run_id: stable name, unique in the study (combination index and seed).
+        seed: the scenario seed.
+        overrides: ``section.key`` -> value for this run (study overrides, case, grid point).
+    """
+
+    run_id: str
+    seed: int
+    overrides: dict[str, Any]
+
+
+@dataclass(frozen=True)
+class StudySpec:
+    """A validated study.
+
+    Attributes:
+        path: the study file.
+        name: study name.
+        scenario: preset name or absolute path of the scenario file.
+        seeds: the seeds.
+        duration_s: overrides ``scenario.duration_s`` when set.
+        tables: table names to keep per run (empty: none; ``("*",)``: all).
+        grid: key -> values crossed.
+        overrides: keys set in every run.
+        cases: explicit combinations crossed with the grid.
+        report: the ``[report]`` section (x, hue, facet, metrics).
+        description: free text for the report.
+    """
+
+    path: Path
+    name: str
+    scenario: str
+    seeds: tuple[int, ...]
+    duration_s: float | None
+    tables: tuple[str, ...]
+    grid: dict[str, list[Any]]
+    overrides: dict[str, Any]
+    cases: tuple[dict[str, Any], ...]
+    report: dict[str, Any]
+    description: str
+
+    def combinations(self) -> list[dict[str, Any]]:
+        """Every override combination, in a fixed order: cases outer, grid inner."""
+        keys = list(self.grid)
+        points = [
+            dict(zip(keys, values, strict=True))
+            for values in itertools.product(*(self.grid[k] for k in keys))
+        ]
+        cases = list(self.cases) or [{}]
+        return [{**self.overrides, **case, **point} for case in cases for point in points]
+
+    def runs(self) -> list[RunSpec]:
+        """Every run: each combination for each seed."""
+        out = []
+        for k, combination in enumerate(self.combinations()):
+            for seed in self.seeds:
+                out.append(RunSpec(f"{k:04d}_s{seed}", seed, dict(combination)))
+        return out
+
+    def varied_keys(self) -> list[str]:
+        """Override keys that differ between runs (grid and cases)."""
+        keys = list(self.grid)
+        for case in self.cases:
+            keys.extend(k for k in case if k not in keys)
+        return keys
+
+
+def _fail(path: Path, where: str, message: str) -> ConfigError:
+    return ConfigError(f"{path}: [{where}] {message}")
+
+
+def _check_keys(path: Path, section: str, table: dict[str, Any], allowed: tuple[str, ...]) -> None:
+    for key in table:
+        if key not in allowed:
+            raise _fail(path, section, f"unknown key {key!r}" + suggest(key, list(allowed)))
+
+
+def _dotted(path: Path, section: str, table: Any) -> dict[str, Any]:
+    if not isinstance(table, dict):
+        raise _fail(path, section, f'= {table!r}: expected a table of "section.key" = value')
+    for key in table:
+        if key.count(".") != 1:
+            raise _fail(
+                path, section, f'key {key!r}: expected "section.key", e.g. "network.latency_ms"'
+            )
+    return dict(table)
+
+
+def load_study(path: str | Path) -> StudySpec:
+    """Read and validate a study file (every combination is checked as a scenario).
+
+    Raises:
+        ConfigError: naming the file, the section, the key, the value and what was expected.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(f"{path}: study file not found")
+    try:
+        raw = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
+        raise ConfigError(f"{path}: malformed TOML: {error}") from None
+    for section in raw:
+        if section not in SECTIONS:
+            raise ConfigError(
+                f"{path}: unknown section [{section}]" + suggest(section, list(SECTIONS))
+            )
+    study = raw.get("study")
+    if not isinstance(study, dict):
+        raise ConfigError(f"{path}: missing [study] section (name, scenario, seeds)")
+    _check_keys(path, "study", study, STUDY_KEYS)
+    for key in ("name", "scenario"):
+        if not isinstance(study.get(key), str) or not study[key]:
+            raise _fail(path, "study", f"{key} = {study.get(key)!r}: expected a non-empty string")
+    scenario = study["scenario"]
+    if scenario not in preset_names():
+        candidate = (path.parent / scenario).resolve()
+        if not candidate.is_file():
+            raise _fail(
+                path,
+                "study",
+                f"scenario = {scenario!r}: expected a preset "
+                f"({', '.join(preset_names())}) or a file next to the study",
+            )
+        scenario = str(candidate)
+    seeds = _seeds(path, study.get("seeds", 1))
+    duration = study.get("duration_s")
+    if duration is not None and (
+        isinstance(duration, bool) or not isinstance(duration, int | float) or duration <= 0
+    ):
+        raise _fail(path, "study", f"duration_s = {duration!r}: expected a number > 0")
+    tables = _tables(path, study.get("tables", False))
+    grid = _dotted(path, "grid", raw.get("grid", {}))
+    for key, values in grid.items():
+        if not isinstance(values, list) or not values:
+            raise _fail(path, "grid", f"{key!r} = {values!r}: expected a non-empty list of values")
+    overrides = _dotted(path, "overrides", raw.get("overrides", {}))
+    cases_raw = raw.get("cases", [])
+    if not isinstance(cases_raw, list):
+        raise _fail(path, "cases", "expected [[cases]] tables")
+    cases = tuple(_dotted(path, f"cases[{i}]", case) for i, case in enumerate(cases_raw))
+    report = raw.get("report", {})
+    if not isinstance(report, dict):
+        raise _fail(path, "report", "expected a table")
+    _check_keys(path, "report", report, REPORT_KEYS)
+    spec = StudySpec(
+        path=path,
+        name=study["name"],
+        scenario=scenario,
+        seeds=seeds,
+        duration_s=float(duration) if duration is not None else None,
+        tables=tables,
+        grid=grid,
+        overrides=overrides,
+        cases=cases,
+        report=report,
+        description=str(study.get("description", "")),
+    )
+    _validate_combinations(spec)
+    return spec
+
+
+def _seeds(path: Path, value: Any) -> tuple[int, ...]:
+    if isinstance(value, int) and not isinstance(value, bool):
+        if value < 1:
+            raise _fail(path, "study", f"seeds = {value}: expected a count >= 1 or a list")
+        return tuple(range(1, value + 1))
+    if (
+        isinstance(value, list)
+        and value
+        and all(isinstance(s, int) and not isinstance(s, bool) and s >= 0 for s in value)
+    ):
+        if len(set(value)) != len(value):
+            raise _fail(path, "study", f"seeds = {value}: expected distinct seeds")
+        return tuple(value)
+    raise _fail(path, "study", f"seeds = {value!r}: expected a count >= 1 or a list of seeds >= 0")
+
+
+def _tables(path: Path, value: Any) -> tuple[str, ...]:
+    if value is False:
+        return ()
+    if value is True:
+        return ("*",)
+    if isinstance(value, list) and all(isinstance(v, str) for v in value):
+        return tuple(value)
+    raise _fail(path, "study", f"tables = {value!r}: expected true, false or a list of table names")
+
+
+def _validate_combinations(spec: StudySpec) -> None:
+    """Load every combination as a scenario: a bad key or value stops the study here."""
+    origin = f"{spec.path} [grid/overrides/cases]"
+    for combination in spec.combinations():
+        overrides = dict(combination)
+        if spec.duration_s is not None:
+            overrides["scenario.duration_s"] = spec.duration_s
+        load_scenario(spec.scenario, overrides, override_origin=origin)

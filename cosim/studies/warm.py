@@ -1,0 +1,23 @@
+"""Imported by the study workers' fork server: load every compiled kernel once.
+
+Study workers fork from a server process; whatever it has loaded, they start with. Running
+one tiny scenario here loads the numba kernels (lidar, planner, local controller, simplex)
+from their cache once, instead of once in every worker.
+"""
+
+from __future__ import annotations
+
+import cosim
+from cosim.runner import execute
+
+_TINY = {
+    "scenario.duration_s": 0.5,
+    "world.size_m": [12.0, 12.0],
+    "world.shelf_count": 2,
+    "robots.count": 2,
+    "tasks.initial": 1,
+    "lidar.beams": 36,
+    "record.messages": False,
+}
+
+execute(cosim.load_scenario("warehouse-random", _TINY))

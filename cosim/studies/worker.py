@@ -1,0 +1,102 @@
+"""Running one run of a study, in whatever process or Dask worker picks it up.
+
+:func:`run_one` takes plain data and returns plain data (a result row and, if asked, the
+run's tables as Parquet bytes), so it can be shipped to another process or machine; the
+study runner alone writes to the study folder.
+"""
+
+from __future__ import annotations
+
+import io
+import time
+import traceback
+from dataclasses import dataclass
+from typing import Any
+
+from cosim.errors import CosimError
+from cosim.runner import execute
+from cosim.scenario import load_scenario
+from cosim.scenario.loader import dump_scenario
+
+VOLATILE_METRICS = ("wall_time_s", "real_time_factor", "python", "version")
+"""Summary entries that depend on the machine, not on the scenario and seed."""
+
+
+@dataclass(frozen=True)
+class Job:
+    """Everything a worker needs for one run.
+
+    Attributes:
+        run_id: the run's id in the study.
+        scenario: preset name or absolute path.
+        seed: scenario seed.
+        duration_s: overrides the scenario's duration when set.
+        overrides: ``section.key`` -> value.
+        tables: table names to return (``("*",)``: all; empty: none).
+    """
+
+    run_id: str
+    scenario: str
+    seed: int
+    duration_s: float | None
+    overrides: dict[str, Any]
+    tables: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What a run gives back.
+
+    Attributes:
+        row: run_id, seed, the overrides, every summary metric, wall_time_s, status, error.
+        scenario_toml: the resolved scenario (empty if it failed to load).
+        summary: the run's summary.
+        tables: Parquet bytes by table name (only those asked for).
+    """
+
+    row: dict[str, Any]
+    scenario_toml: str
+    summary: dict[str, Any]
+    tables: dict[str, bytes]
+
+
+def run_one(job: Job) -> Outcome:
+    """Run one study run; failures come back as a row with status ``error``, never raise."""
+    start = time.perf_counter()
+    row: dict[str, Any] = {"run_id": job.run_id, "seed": job.seed, **job.overrides}
+    try:
+        overrides = dict(job.overrides)
+        overrides["scenario.seed"] = job.seed
+        if job.duration_s is not None:
+            overrides["scenario.duration_s"] = job.duration_s
+        scenario = load_scenario(job.scenario, overrides, override_origin="study")
+        result = execute(scenario)
+    except CosimError as error:
+        row.update(
+            status="error", error=str(error), wall_time_s=round(time.perf_counter() - start, 4)
+        )
+        return Outcome(row, "", {}, {})
+    except Exception as error:  # a bug in a run must not stop the study
+        detail = "".join(traceback.format_exception_only(type(error), error)).strip()
+        row.update(
+            status="error",
+            error=f"internal error: {detail}",
+            wall_time_s=round(time.perf_counter() - start, 4),
+        )
+        return Outcome(row, "", {}, {})
+    summary = result.summary
+    for key, value in summary.items():
+        if key not in ("scenario", "source", "seed"):
+            row[key] = value
+    row.update(status="ok", error="", wall_time_s=summary["wall_time_s"])
+    wanted = (
+        result.tables
+        if "*" in job.tables
+        else {name: frame for name, frame in result.tables.items() if name in job.tables}
+    )
+    tables = {}
+    for name, frame in wanted.items():
+        buffer = io.BytesIO()
+        frame.to_parquet(buffer, index=False)
+        tables[name] = buffer.getvalue()
+    return Outcome(row, dump_scenario(scenario), summary, tables)

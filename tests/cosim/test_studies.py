@@ -1,0 +1,233 @@
+"""The study runner: validation, executors (local and a real Dask cluster), resume."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+import cosim
+from cosim.errors import ConfigError
+from cosim.studies import load_study, run_study
+from cosim.studies.worker import VOLATILE_METRICS
+
+TINY = """
+[study]
+name = "tiny"
+scenario = "warehouse-random"
+seeds = 2
+duration_s = {duration}
+
+[grid]
+"network.latency_ms" = [0, 50]
+"assignment.protocol" = ["distributed_simplex", "greedy"]
+
+[overrides]
+"world.size_m" = [16.0, 16.0]
+"world.shelf_count" = 6
+"robots.count" = 3
+"record.messages" = false
+"""
+
+
+def _study(tmp_path: Path, text: str = TINY, duration: float = 10.0) -> Path:
+    path = tmp_path / "study.toml"
+    path.write_text(text.format(duration=duration) if "{duration}" in text else text)
+    return path
+
+
+def _comparable(frame: pd.DataFrame) -> pd.DataFrame:
+    frame = frame.drop(columns=[c for c in VOLATILE_METRICS if c in frame.columns])
+    return frame.sort_values("run_id").reset_index(drop=True)
+
+
+def cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "cosim", *args], capture_output=True, text=True, timeout=300, cwd=cwd
+    )
+
+
+def test_a_study_expands_every_combination_for_every_seed(tmp_path):
+    spec = load_study(_study(tmp_path))
+    runs = spec.runs()
+    assert len(runs) == 2 * 2 * 2
+    assert len({r.run_id for r in runs}) == len(runs)
+    assert runs[0].overrides["network.latency_ms"] == 0
+    assert runs[0].overrides["world.shelf_count"] == 6
+
+
+def test_results_are_identical_in_process_and_on_two_local_workers(tmp_path):
+    spec = load_study(_study(tmp_path))
+    one = run_study(spec, tmp_path / "one", workers=1)
+    two = run_study(spec, tmp_path / "two", workers=2)
+    assert len(one) == 8 and set(one["status"]) == {"ok"}
+    pd.testing.assert_frame_equal(_comparable(one), _comparable(two))
+    assert (tmp_path / "two" / "runs" / "0003_s2" / "summary.json").exists()
+
+
+@pytest.fixture
+def dask_cluster(tmp_path):
+    """A real Dask scheduler and two workers, separate processes on loopback."""
+    bin_dir = Path(sys.executable).parent
+    scheduler_file = tmp_path / "scheduler.json"
+    env = {**os.environ, "DASK_DISTRIBUTED__WORKER__DAEMON": "False"}
+    procs = [
+        subprocess.Popen(
+            [
+                str(bin_dir / "dask"),
+                "scheduler",
+                "--host",
+                "127.0.0.1",
+                "--port",
+                "0",
+                "--no-dashboard",
+                "--scheduler-file",
+                str(scheduler_file),
+            ],
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            env=env,
+        )
+    ]
+    try:
+        deadline = time.monotonic() + 60
+        while not scheduler_file.exists() and time.monotonic() < deadline:
+            time.sleep(0.2)
+        assert scheduler_file.exists(), "dask scheduler did not start"
+        for _ in range(2):
+            procs.append(
+                subprocess.Popen(
+                    [
+                        str(bin_dir / "dask"),
+                        "worker",
+                        "--scheduler-file",
+                        str(scheduler_file),
+                        "--nworkers",
+                        "1",
+                        "--nthreads",
+                        "1",
+                        "--no-dashboard",
+                        "--host",
+                        "127.0.0.1",
+                    ],
+                    stdout=subprocess.DEVNULL,
+                    stderr=subprocess.DEVNULL,
+                    env=env,
+                )
+            )
+        address = json.loads(scheduler_file.read_text())["address"]
+        from distributed import Client
+
+        with Client(address, timeout="30s") as client:
+            client.wait_for_workers(2, timeout=60)
+        yield address
+    finally:
+        for proc in reversed(procs):
+            proc.terminate()
+        for proc in procs:
+            try:
+                proc.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+
+
+@pytest.mark.slow
+def test_a_study_gives_the_same_rows_on_a_real_dask_cluster_as_locally(tmp_path, dask_cluster):
+    spec = load_study(_study(tmp_path))
+    local = run_study(spec, tmp_path / "local", workers=1)
+    remote = run_study(spec, tmp_path / "dask", scheduler=dask_cluster)
+    assert set(remote["status"]) == {"ok"}
+    pd.testing.assert_frame_equal(_comparable(local), _comparable(remote))
+
+
+@pytest.mark.slow
+def test_a_study_killed_mid_way_and_resumed_has_every_run_exactly_once(tmp_path):
+    path = _study(tmp_path, duration=40.0)
+    out = tmp_path / "out"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "cosim", "study", str(path), "--out", str(out), "--workers", "1"],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    deadline = time.monotonic() + 120
+    runs = out / "runs"
+    while time.monotonic() < deadline:
+        finished = (
+            [p for p in runs.glob("*") if not p.name.endswith(".partial")] if runs.exists() else []
+        )
+        if len(finished) >= 2:
+            break
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    killed_with = len([p for p in runs.glob("*") if not p.name.endswith(".partial")])
+    assert 2 <= killed_with < 8
+    refused = cli("study", str(path), "--out", str(out))
+    assert refused.returncode == 2 and "--resume" in refused.stderr
+    resumed = cli("study", str(path), "--out", str(out), "--resume", "--workers", "2")
+    assert resumed.returncode == 0, resumed.stderr
+    results = pd.read_parquet(out / "results.parquet")
+    assert sorted(results["run_id"]) == sorted(r.run_id for r in load_study(path).runs())
+    assert results["run_id"].is_unique
+    assert not list(runs.glob("*.partial"))
+    assert len(list(runs.iterdir())) == 8
+
+
+def test_a_failing_run_is_recorded_and_the_others_go_on(tmp_path):
+    text = TINY.replace('"world.shelf_count" = 6\n', "").replace(
+        '"assignment.protocol" = ["distributed_simplex", "greedy"]',
+        '"world.shelf_count" = [6, 400]',
+    )
+    results = run_study(load_study(_study(tmp_path, text)), tmp_path / "out", workers=1)
+    failed = results[results["status"] == "error"]
+    assert len(failed) == 4 and len(results) == 8
+    assert failed["error"].str.contains("world.shelf_count = 400").all()
+    assert set(results.loc[results["status"] == "ok", "world.shelf_count"]) == {6}
+
+
+@pytest.mark.parametrize(
+    ("edit", "fragment"),
+    [
+        (
+            lambda t: t.replace('"network.latency_ms"', '"network.latency_mz"'),
+            "unknown key 'latency_mz'; did you mean 'latency_ms'?",
+        ),
+        (lambda t: t.replace("[0, 50]", "[]"), "expected a non-empty list of values"),
+        (lambda t: t.replace("[0, 50]", "[0, -50]"), "latency_ms = -50: expected a number >= 0"),
+        (lambda t: t.replace("seeds = 2", "seeds = 0"), "seeds = 0"),
+        (
+            lambda t: t.replace('scenario = "warehouse-random"', 'scenario = "nowhere.toml"'),
+            "scenario = 'nowhere.toml'",
+        ),
+        (lambda t: t + "\n[plots]\nx = 1\n", "unknown section [plots]"),
+    ],
+)
+def test_a_bad_study_file_exits_2_naming_the_key(tmp_path, edit, fragment):
+    path = _study(tmp_path, edit(TINY.format(duration=5.0)))
+    done = cli("study", str(path), "--out", str(tmp_path / "out"))
+    assert done.returncode == 2, done.stdout
+    assert fragment in done.stderr and str(path) in done.stderr
+    assert done.stderr.count("\n") == 1, done.stderr
+    assert not (tmp_path / "out").exists()
+    with pytest.raises(ConfigError):
+        load_study(path)
+
+
+def test_the_python_api_returns_one_row_per_run(tmp_path):
+    frame = cosim.study(_study(tmp_path, duration=5.0), tmp_path / "out", workers=1)
+    assert len(frame) == 8
+    assert {
+        "run_id",
+        "seed",
+        "network.latency_ms",
+        "assignment.protocol",
+        "tasks_per_min",
+        "wall_time_s",
+        "status",
+        "error",
+    } <= set(frame.columns)
