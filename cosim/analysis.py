@@ -283,7 +283,7 @@ def write_report(
         lines += _tables(ok, by, metrics)
     lines += ["## Figures", ""] if figures else []
     for png in map(Path, figures):
-        link = Path(os.path.relpath(png, study_dir)) if png.is_absolute() else png
+        link = Path(os.path.relpath(png, study_dir))
         lines += [f"![{png.stem}]({link.as_posix()})", ""]
     path = study_dir / REPORT_FILE
     try:

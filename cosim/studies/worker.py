@@ -8,6 +8,7 @@ study runner alone writes to the study folder.
 from __future__ import annotations
 
 import io
+import json
 import time
 import traceback
 from dataclasses import dataclass
@@ -60,10 +61,22 @@ class Outcome:
     tables: dict[str, bytes]
 
 
+def _cell(value: Any) -> Any:
+    """A table cell for an override: lists (e.g. ``world.size_m``) become their JSON text.
+
+    Array cells cannot be grouped or compared by pandas, so ``[15.0, 15.0]`` is kept as the
+    string ``"[15.0, 15.0]"``; scalars are kept as they are.
+    """
+    if isinstance(value, list | tuple):
+        return json.dumps(list(value))
+    return value
+
+
 def run_one(job: Job) -> Outcome:
     """Run one study run; failures come back as a row with status ``error``, never raise."""
     start = time.perf_counter()
-    row: dict[str, Any] = {"run_id": job.run_id, "seed": job.seed, **job.overrides}
+    row: dict[str, Any] = {"run_id": job.run_id, "seed": job.seed}
+    row.update((key, _cell(value)) for key, value in job.overrides.items())
     try:
         overrides = dict(job.overrides)
         overrides["scenario.seed"] = job.seed

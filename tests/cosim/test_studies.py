@@ -231,3 +231,19 @@ def test_the_python_api_returns_one_row_per_run(tmp_path):
         "status",
         "error",
     } <= set(frame.columns)
+
+
+def test_a_list_valued_override_becomes_a_text_column_the_report_can_group(tmp_path, monkeypatch):
+    text = TINY.replace('"world.size_m" = [16.0, 16.0]\n', "") + (
+        '\n[[cases]]\n"world.size_m" = [16.0, 16.0]\n'
+        '\n[[cases]]\n"world.size_m" = [18.0, 18.0]\n'
+        '\n[report]\nx = "network.latency_ms"\nhue = "world.size_m"\n'
+        'metrics = ["tasks_per_min"]\n'
+    )
+    text = text.replace('"assignment.protocol" = ["distributed_simplex", "greedy"]\n', "")
+    results = run_study(
+        load_study(_study(tmp_path, text, duration=5.0)), tmp_path / "out", workers=1
+    )
+    assert set(results["world.size_m"]) == {"[16.0, 16.0]", "[18.0, 18.0]"}
+    report = (tmp_path / "out" / "report.md").read_text()
+    assert "[18.0, 18.0]" in report
