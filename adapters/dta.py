@@ -193,7 +193,7 @@ class DtaAdapter:
             robot.protocol = GreedyProtocol(problem, robot.index, taken)
         else:
             robot.protocol = None  # orders come from the base station
-        self.records.epoch_seen(robot.index, tasks.epoch, now, problem)
+        self.records.epoch_seen(robot.index, tasks.epoch, tasks.stamp_ns, problem)
 
     def _problem(self, robot: RobotTasks, tasks: tuple[TaskInfo, ...]) -> AssignmentProblem:
         """This robot's row of costs (the other rows are other robots' business)."""

@@ -66,9 +66,21 @@ class DtaRecords:
         self.incomplete = 0
         self.compare = compare
 
-    def epoch_seen(self, robot: int, epoch: int, now_ns: int, problem: AssignmentProblem) -> None:
-        """A robot starts working on ``epoch`` with its own cost row."""
-        record = self.epochs.setdefault(epoch, _Epoch(now_ns))
+    def epoch_seen(
+        self, robot: int, epoch: int, announced_ns: int, problem: AssignmentProblem
+    ) -> None:
+        """A robot starts working on ``epoch`` with its own cost row.
+
+        Args:
+            robot: fleet index of the robot.
+            epoch: the epoch it received.
+            announced_ns: send time of the copy of the task set it received (ns). The epoch
+                starts at the earliest such time: convergence is measured from the source's
+                announcement, so network latency counts, as it does for the fleet.
+            problem: the robot's view of the problem (its own row filled).
+        """
+        record = self.epochs.setdefault(epoch, _Epoch(announced_ns))
+        record.start_ns = min(record.start_ns, announced_ns)
         record.rows[robot] = np.array(problem.cost[robot])
         if record.problem is None:
             record.problem = problem

@@ -309,7 +309,7 @@ def study_throughput(repeat: int) -> Result:
         "runs_per_min_2_workers": round(two, 2),
         "speedup_2_workers": round(two / one, 3),
         "target_speedup": 1.8,
-        "note": "2 workers are spawned processes (start-up included); 1 worker runs in-process",
+        "note": "2 workers are forkserver processes (start-up included); 1 worker runs in-process",
     }
 
 

@@ -166,3 +166,15 @@ def test_the_same_seed_gives_the_same_tables_for_the_full_loop():
     for name in ("tasks", "assignments", "poses", "navigation"):
         pd.testing.assert_frame_equal(left[name], right[name])
     assert np.isclose(first.summary["tasks_per_min"], second.summary["tasks_per_min"])
+
+
+def test_convergence_is_timed_from_the_announcement_so_more_latency_never_shortens_it():
+    # both latencies are below the 100 ms round period: the robots decide at the same round
+    # ticks, so timed from the announcement the convergence times are equal; timed from each
+    # robot's reception they would shrink by the extra latency
+    short, long = (
+        _run(**{"network.latency_ms": ms, "scenario.duration_s": 60.0}) for ms in (20.0, 60.0)
+    )
+    assert short.summary["epochs"] >= 3
+    assert long.summary["mean_convergence_time_s"] >= short.summary["mean_convergence_time_s"]
+    assert short.summary["mean_convergence_time_s"] > 0.02
