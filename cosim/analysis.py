@@ -268,7 +268,8 @@ def write_report(
     ok, failed = results[results["status"] == "ok"], results[results["status"] != "ok"]
     lines = [f"# {name}", ""] + ([description.strip(), ""] if description.strip() else [])
     seeds = results["seed"].nunique()
-    lines += ["## Runs", "", f"{len(ok)} ok, {len(failed)} failed, over {seeds} seeds.", ""]
+    over = f"{seeds} seed" + ("s" if seeds != 1 else "")
+    lines += ["## Runs", "", f"{len(ok)} ok, {len(failed)} failed, over {over}.", ""]
     if len(failed):
         lines += ["### Failed runs", ""]
         for run in failed.head(ERRORS_LISTED).itertuples(index=False):

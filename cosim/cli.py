@@ -168,6 +168,9 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="continue a study in --out: skip finished runs, retry failed ones",
     )
+    study.add_argument(
+        "--quiet", action="store_true", help="no progress bar (the summary lines remain)"
+    )
 
     commands.add_parser(
         "scenarios",
@@ -275,7 +278,7 @@ def _cmd_study(args: argparse.Namespace) -> int:
         workers=args.workers,
         scheduler=args.scheduler,
         resume=args.resume,
-        progress=Progress(total, args.workers or 1),
+        progress=None if args.quiet else Progress(),
     )
     failed = int((results["status"] != "ok").sum()) if len(results) else 0
     print(

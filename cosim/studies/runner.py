@@ -20,11 +20,11 @@ import os
 import shutil
 import sys
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from concurrent.futures import Future, ProcessPoolExecutor, as_completed
 from multiprocessing import get_context
 from pathlib import Path
-from typing import TextIO
+from typing import Protocol, TextIO
 
 import pandas as pd
 
@@ -153,36 +153,76 @@ def _dask(jobs: list[Job], scheduler: str) -> Iterator[Outcome]:
         client.close()  # type: ignore[no-untyped-call]
 
 
-class Progress:
-    """Runs done, errors and the time left, on one terminal line (or a line per 10 %)."""
+def _clock(seconds: float) -> str:
+    """``1h02m03s``, ``2m03s`` or ``3s``."""
+    whole = round(seconds)
+    hours, rest = divmod(whole, 3600)
+    minutes, secs = divmod(rest, 60)
+    if hours:
+        return f"{hours}h{minutes:02d}m{secs:02d}s"
+    return f"{minutes}m{secs:02d}s" if minutes else f"{secs}s"
 
-    def __init__(self, total: int, workers: int, stream: TextIO | None = None) -> None:
-        self.total = total
-        self.workers = max(1, workers)
+
+class StudyProgress(Protocol):
+    """What :func:`run_study` reports to while it runs."""
+
+    def begin(self, total: int, already_done: int) -> None:
+        """The study has ``total`` runs, ``already_done`` of them finished earlier."""
+
+    def __call__(self, outcome: Outcome) -> None:
+        """One more run finished (``outcome.row["status"]`` tells how)."""
+
+
+class Progress:
+    """A progress bar with the time left; on a pipe, a plain line per tenth of the study.
+
+    The time left is the mean wall time per run finished in this session times the runs
+    still to do, so runs skipped on ``--resume`` count as done but not as fast.
+    """
+
+    WIDTH = 24
+
+    def __init__(self, stream: TextIO | None = None) -> None:
         self.stream = stream if stream is not None else sys.stderr
         self.tty = self.stream.isatty()
-        self.start = time.perf_counter()
+        self.total = 0
         self.done = 0
         self.errors = 0
-        self._last_decile = -1
+        self._session_done = 0
+        self._start = time.perf_counter()
+        self._last_tenth = -1
+
+    def begin(self, total: int, already_done: int) -> None:
+        """Start the clock; ``already_done`` runs finished before this session."""
+        self.total = total
+        self.done = already_done
+        self._start = time.perf_counter()
+        if already_done:
+            self.stream.write(f"study: resuming, {already_done}/{total} runs already done\n")
+            self.stream.flush()
 
     def __call__(self, outcome: Outcome) -> None:
         """Count one finished run and show where the study is."""
         self.done += 1
+        self._session_done += 1
         self.errors += outcome.row.get("status") != "ok"
-        elapsed = time.perf_counter() - self.start
-        left = elapsed / self.done * (self.total - self.done)
-        text = (
-            f"study: {self.done}/{self.total} runs, {self.errors} failed, "
-            f"{elapsed:.0f} s elapsed, about {left:.0f} s left"
+        elapsed = time.perf_counter() - self._start
+        left = elapsed / self._session_done * (self.total - self.done)
+        figures = (
+            f"{self.done}/{self.total} runs, {self.errors} failed, "
+            f"{_clock(elapsed)} elapsed, {_clock(left)} left"
         )
         if self.tty:
-            self.stream.write("\r" + text)
+            filled = self.WIDTH * self.done // max(self.total, 1)
+            bar = "#" * filled + "-" * (self.WIDTH - filled)
+            self.stream.write(f"\rstudy [{bar}] {figures}\x1b[K")
             if self.done == self.total:
                 self.stream.write("\n")
-        elif self.done * 10 // max(self.total, 1) != self._last_decile:
-            self._last_decile = self.done * 10 // max(self.total, 1)
-            self.stream.write(text + "\n")
+        else:
+            tenth = self.done * 10 // max(self.total, 1)
+            if tenth != self._last_tenth:
+                self._last_tenth = tenth
+                self.stream.write(f"study: {figures}\n")
         self.stream.flush()
 
 
@@ -206,7 +246,7 @@ def run_study(
     workers: int | None = None,
     scheduler: str | None = None,
     resume: bool = False,
-    progress: Callable[[Outcome], None] | None = None,
+    progress: StudyProgress | None = None,
     report: bool = True,
 ) -> pd.DataFrame:
     """Run a study and return its results (one row per run).
@@ -217,7 +257,7 @@ def run_study(
         workers: local processes (default: the machine's cores); ignored with ``scheduler``.
         scheduler: address of a Dask scheduler (``tcp://host:port``) to run on instead.
         resume: continue a study in ``out``: skip finished runs, retry failed ones.
-        progress: called after every finished run.
+        progress: told the run count, then called after every finished run.
         report: write figures and report.md when the study has a ``[report]`` section.
 
     Raises:
@@ -229,6 +269,8 @@ def run_study(
     runs = [r for r in spec.runs() if r.run_id not in done]
     jobs = _jobs(spec, runs)
     workers = workers or os.cpu_count() or 1
+    if progress is not None:
+        progress.begin(len(spec.runs()), len(done))
     outcomes = _dask(jobs, scheduler) if scheduler else _local(jobs, workers)
     for outcome in outcomes:
         _write_run(out, outcome)
@@ -242,4 +284,4 @@ def run_study(
     return results
 
 
-__all__ = ["Progress", "collect", "run_study"]
+__all__ = ["Progress", "StudyProgress", "collect", "run_study"]

@@ -1,5 +1,6 @@
 """The study runner: validation, executors (local and a real Dask cluster), resume."""
 
+import io
 import json
 import os
 import signal
@@ -14,7 +15,8 @@ import pytest
 import cosim
 from cosim.errors import ConfigError
 from cosim.studies import load_study, run_study
-from cosim.studies.worker import VOLATILE_METRICS
+from cosim.studies.runner import Progress
+from cosim.studies.worker import VOLATILE_METRICS, Outcome
 
 TINY = """
 [study]
@@ -171,6 +173,8 @@ def test_a_study_killed_mid_way_and_resumed_has_every_run_exactly_once(tmp_path)
     assert refused.returncode == 2 and "--resume" in refused.stderr
     resumed = cli("study", str(path), "--out", str(out), "--resume", "--workers", "2")
     assert resumed.returncode == 0, resumed.stderr
+    assert f"resuming, {killed_with}/8 runs already done" in resumed.stderr
+    assert "study: 8/8 runs, 0 failed" in resumed.stderr
     results = pd.read_parquet(out / "results.parquet")
     assert sorted(results["run_id"]) == sorted(r.run_id for r in load_study(path).runs())
     assert results["run_id"].is_unique
@@ -247,3 +251,36 @@ def test_a_list_valued_override_becomes_a_text_column_the_report_can_group(tmp_p
     assert set(results["world.size_m"]) == {"[16.0, 16.0]", "[18.0, 18.0]"}
     report = (tmp_path / "out" / "report.md").read_text()
     assert "[18.0, 18.0]" in report
+
+
+class _Terminal(io.StringIO):
+    def isatty(self) -> bool:
+        return True
+
+
+def _outcome(status: str) -> Outcome:
+    return Outcome(row={"run_id": "r", "status": status}, summary={}, scenario_toml="", tables={})
+
+
+def test_the_progress_bar_counts_resumed_runs_and_failures_and_ends_the_line():
+    terminal = _Terminal()
+    progress = Progress(terminal)
+    progress.begin(total=4, already_done=2)
+    progress(_outcome("ok"))
+    progress(_outcome("error"))
+    text = terminal.getvalue()
+    assert "resuming, 2/4 runs already done" in text
+    assert "[##################------] 3/4 runs, 0 failed" in text
+    assert "[########################] 4/4 runs, 1 failed" in text
+    assert text.endswith("\n")
+
+
+def test_progress_on_a_pipe_writes_a_line_per_tenth_of_the_study():
+    pipe = io.StringIO()
+    progress = Progress(pipe)
+    progress.begin(total=100, already_done=0)
+    for _ in range(100):
+        progress(_outcome("ok"))
+    lines = pipe.getvalue().splitlines()
+    assert len(lines) == 11  # the first run, then every tenth
+    assert lines[-1].startswith("study: 100/100 runs, 0 failed")
