@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from cosim.analysis import standard_figures, write_report
+from cosim.analysis import FIGURES_DIR, heatmap, load_results, standard_figures, write_report
 from cosim.studies.spec import StudySpec
 
 DEFAULT_METRICS = (
@@ -26,6 +26,14 @@ def report_study(spec: StudySpec, out: Path) -> Path:
     facet = report.get("facet")
     metrics = list(report.get("metrics", DEFAULT_METRICS))
     figures = standard_figures(out, x=x, hue=hue, metrics=metrics, facet=facet)
+    heatmaps = list(report.get("heatmaps", []))
+    if heatmaps and x is not None and facet is not None:
+        results = load_results(out)
+        ok = results[results["status"] == "ok"]
+        for metric in heatmaps:
+            if metric in ok.columns and ok[metric].notna().any():
+                target = out / FIGURES_DIR / f"{metric}_over_{x}_and_{facet}.png"
+                figures.append(heatmap(ok, x=x, y=facet, metric=metric, facet=hue, out=target))
     return write_report(
         out,
         name=spec.name,

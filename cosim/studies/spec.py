@@ -24,6 +24,7 @@ x = "network.latency_ms"
 hue = "assignment.protocol"
 facet = "network.loss_prob"
 metrics = ["tasks_per_min", "optimality_gap"]
+heatmaps = ["tasks_per_min"]       # optional: x by facet, a panel per hue value
 ```
 
 Every combination is loaded as a scenario before the study starts, so a bad key or value in
@@ -45,7 +46,7 @@ from cosim.scenario.loader import preset_names
 
 SECTIONS = ("study", "grid", "overrides", "cases", "report")
 STUDY_KEYS = ("name", "scenario", "seeds", "duration_s", "tables", "description")
-REPORT_KEYS = ("x", "hue", "facet", "metrics")
+REPORT_KEYS = ("x", "hue", "facet", "metrics", "heatmaps")
 
 
 @dataclass(frozen=True)
@@ -77,7 +78,7 @@ class StudySpec:
         grid: key -> values crossed.
         overrides: keys set in every run.
         cases: explicit combinations crossed with the grid.
-        report: the ``[report]`` section (x, hue, facet, metrics).
+        report: the ``[report]`` section (x, hue, facet, metrics, heatmaps).
         description: free text for the report.
     """
 
@@ -196,6 +197,7 @@ def load_study(path: str | Path) -> StudySpec:
     if not isinstance(report, dict):
         raise _fail(path, "report", "expected a table")
     _check_keys(path, "report", report, REPORT_KEYS)
+    _check_report(path, report, grid, overrides, cases)
     spec = StudySpec(
         path=path,
         name=study["name"],
@@ -237,6 +239,40 @@ def _tables(path: Path, value: Any) -> tuple[str, ...]:
     if isinstance(value, list) and all(isinstance(v, str) for v in value):
         return tuple(value)
     raise _fail(path, "study", f"tables = {value!r}: expected true, false or a list of table names")
+
+
+def _check_report(
+    path: Path,
+    report: dict[str, Any],
+    grid: dict[str, Any],
+    overrides: dict[str, Any],
+    cases: tuple[dict[str, Any], ...],
+) -> None:
+    """Column names are strings, and a dotted one is a key the study sets.
+
+    Undotted names are summary metrics (or ``seed``), known only once runs finish; a metric
+    no run reports is noted in the report rather than failing a finished study.
+    """
+    study_keys = {*grid, *overrides, *(k for case in cases for k in case)}
+    for key in ("x", "hue", "facet"):
+        if key not in report:
+            continue
+        value = report[key]
+        if not isinstance(value, str) or not value:
+            raise _fail(path, "report", f"{key} = {value!r}: expected a column name")
+        if "." in value and value not in study_keys:
+            raise _fail(
+                path,
+                "report",
+                f"{key} = {value!r}: not a key this study sets (expected one of "
+                f"{', '.join(sorted(study_keys)) or 'none'}, or a summary metric)",
+            )
+    for key in ("metrics", "heatmaps"):
+        value = report.get(key, [])
+        if not isinstance(value, list) or not all(isinstance(m, str) and m for m in value):
+            raise _fail(path, "report", f"{key} = {value!r}: expected a list of metric names")
+    if report.get("heatmaps") and not ("x" in report and "facet" in report):
+        raise _fail(path, "report", "heatmaps need x and facet (the heatmap's columns and rows)")
 
 
 def _validate_combinations(spec: StudySpec) -> None:

@@ -209,6 +209,18 @@ def test_a_failing_run_is_recorded_and_the_others_go_on(tmp_path):
             "scenario = 'nowhere.toml'",
         ),
         (lambda t: t + "\n[plots]\nx = 1\n", "unknown section [plots]"),
+        (
+            lambda t: t + '\n[report]\nx = "network.latency_mz"\n',
+            "[report] x = 'network.latency_mz': not a key this study sets",
+        ),
+        (
+            lambda t: t + '\n[report]\nmetrics = "tasks_per_min"\n',
+            "[report] metrics = 'tasks_per_min': expected a list of metric names",
+        ),
+        (
+            lambda t: t + '\n[report]\nx = "network.latency_ms"\nheatmaps = ["conflicts"]\n',
+            "heatmaps need x and facet",
+        ),
     ],
 )
 def test_a_bad_study_file_exits_2_naming_the_key(tmp_path, edit, fragment):
@@ -253,6 +265,17 @@ def test_a_list_valued_override_becomes_a_text_column_the_report_can_group(tmp_p
     assert "[18.0, 18.0]" in report
 
 
+def test_a_report_with_heatmaps_draws_one_per_metric_and_links_it(tmp_path):
+    text = TINY + (
+        '\n[report]\nx = "network.latency_ms"\nfacet = "assignment.protocol"\n'
+        'metrics = ["tasks_per_min"]\nheatmaps = ["tasks_per_min"]\n'
+    )
+    run_study(load_study(_study(tmp_path, text, duration=5.0)), tmp_path / "out", workers=1)
+    name = "tasks_per_min_over_network.latency_ms_and_assignment.protocol.png"
+    assert (tmp_path / "out" / "figures" / name).stat().st_size > 10_000
+    assert f"(figures/{name})" in (tmp_path / "out" / "report.md").read_text()
+
+
 class _Terminal(io.StringIO):
     def isatty(self) -> bool:
         return True
@@ -284,3 +307,14 @@ def test_progress_on_a_pipe_writes_a_line_per_tenth_of_the_study():
     lines = pipe.getvalue().splitlines()
     assert len(lines) == 11  # the first run, then every tenth
     assert lines[-1].startswith("study: 100/100 runs, 0 failed")
+
+
+SHIPPED = sorted((Path(__file__).parents[2] / "studies").glob("*.toml"))
+
+
+@pytest.mark.parametrize("path", SHIPPED, ids=[p.stem for p in SHIPPED])
+def test_every_shipped_study_file_loads_with_a_report_and_distinct_run_ids(path):
+    spec = load_study(path)
+    runs = spec.runs()
+    assert runs and len({r.run_id for r in runs}) == len(runs)
+    assert spec.report, f"{path.name} has no [report]"
