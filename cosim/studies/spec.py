@@ -39,7 +39,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from cosim.assembly import adapter_names
 from cosim.errors import ConfigError
+from cosim.runner import execute
 from cosim.scenario import load_scenario
 from cosim.scenario.fields import suggest
 from cosim.scenario.loader import preset_names
@@ -276,10 +278,28 @@ def _check_report(
 
 
 def _validate_combinations(spec: StudySpec) -> None:
-    """Load every combination as a scenario: a bad key or value stops the study here."""
+    """Load every combination as a scenario: a bad key or value stops the study here.
+
+    When the study keeps named tables, one scenario per distinct set of adapters is also run
+    for a millisecond (adapters create some tables only when they finish), so a table no run
+    would produce is reported now rather than by every run.
+    """
     origin = f"{spec.path} [grid/overrides/cases]"
+    named = [t for t in spec.tables if t != "*"]
+    checked: set[tuple[str, ...]] = set()
     for combination in spec.combinations():
         overrides = dict(combination)
         if spec.duration_s is not None:
             overrides["scenario.duration_s"] = spec.duration_s
-        load_scenario(spec.scenario, overrides, override_origin=origin)
+        scenario = load_scenario(spec.scenario, overrides, override_origin=origin)
+        if named and (names := tuple(adapter_names(scenario))) not in checked:
+            checked.add(names)
+            have = set(execute(scenario.with_duration(0.001)).tables)
+            if missing := [t for t in named if t not in have]:
+                raise _fail(
+                    spec.path,
+                    "study",
+                    f"tables = {list(spec.tables)!r}: no run of this study has "
+                    f"{', '.join(map(repr, missing))} (expected some of "
+                    f"{', '.join(sorted(have))})",
+                )

@@ -210,6 +210,10 @@ def test_a_failing_run_is_recorded_and_the_others_go_on(tmp_path):
         ),
         (lambda t: t + "\n[plots]\nx = 1\n", "unknown section [plots]"),
         (
+            lambda t: t.replace("seeds = 2", 'seeds = 2\ntables = ["poses", "pose"]'),
+            "tables = ['poses', 'pose']: no run of this study has 'pose' (expected some of",
+        ),
+        (
             lambda t: t + '\n[report]\nx = "network.latency_mz"\n',
             "[report] x = 'network.latency_mz': not a key this study sets",
         ),
@@ -263,6 +267,27 @@ def test_a_list_valued_override_becomes_a_text_column_the_report_can_group(tmp_p
     assert set(results["world.size_m"]) == {"[16.0, 16.0]", "[18.0, 18.0]"}
     report = (tmp_path / "out" / "report.md").read_text()
     assert "[18.0, 18.0]" in report
+
+
+def test_each_run_folder_keeps_its_scenario_summary_and_only_the_tables_asked_for(tmp_path):
+    text = TINY.replace("seeds = 2", 'seeds = 1\ntables = ["poses", "tasks"]')
+    out = tmp_path / "out"
+    run_study(load_study(_study(tmp_path, text, duration=5.0)), out, workers=1)
+    folders = sorted((out / "runs").iterdir())
+    assert len(folders) == 4
+    for folder in folders:
+        assert {p.name for p in folder.iterdir()} == {
+            "row.json",
+            "summary.json",
+            "scenario.toml",
+            "tables",
+        }
+        assert {p.name for p in (folder / "tables").iterdir()} == {
+            "poses.parquet",
+            "tasks.parquet",
+        }
+        poses = pd.read_parquet(folder / "tables" / "poses.parquet")
+        assert poses["t_s"].max() == pytest.approx(5.0, abs=0.2)
 
 
 def test_a_report_with_heatmaps_draws_one_per_metric_and_links_it(tmp_path):
