@@ -28,5 +28,9 @@ class ExportError(CosimError):
     """Results cannot be written (existing output folder, unwritable path, ...)."""
 
 
+class WorkerError(CosimError):
+    """A study's worker process died or its Dask cluster went away mid-study."""
+
+
 class BridgeError(CosimError):
     """An external system (DDS, SUMO, motion capture) cannot be reached or misbehaves."""

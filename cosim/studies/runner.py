@@ -22,15 +22,16 @@ import sys
 import time
 from collections.abc import Iterator
 from concurrent.futures import Future, ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from multiprocessing import get_context
 from pathlib import Path
 from typing import Protocol, TextIO
 
 import pandas as pd
 
-from cosim.errors import ConfigError, ExportError
+from cosim.errors import ConfigError, ExportError, WorkerError
 from cosim.studies.spec import RunSpec, StudySpec
-from cosim.studies.worker import Job, Outcome, run_one
+from cosim.studies.worker import Job, Outcome, failed, run_one
 
 
 def _jobs(spec: StudySpec, runs: list[RunSpec]) -> list[Job]:
@@ -128,7 +129,13 @@ def _local(jobs: list[Job], workers: int) -> Iterator[Outcome]:
         futures: list[Future[Outcome]] = [pool.submit(run_one, job) for job in jobs]
         try:
             for future in as_completed(futures):
-                yield future.result()
+                try:
+                    outcome = future.result()
+                except BrokenProcessPool:
+                    raise WorkerError(
+                        "a worker process died (killed, or out of memory) while running a run"
+                    ) from None
+                yield outcome
         finally:
             for future in futures:
                 future.cancel()
@@ -146,9 +153,19 @@ def _dask(jobs: list[Job], scheduler: str) -> Iterator[Outcome]:
             f"--scheduler {scheduler}: cannot reach a Dask scheduler ({error})"
         ) from None
     try:
-        futures = client.map(run_one, jobs, key=[f"cosim-{job.run_id}" for job in jobs], pure=False)
+        keys = [f"cosim-{job.run_id}" for job in jobs]
+        by_key = dict(zip(keys, jobs, strict=True))
+        futures = client.map(run_one, jobs, key=keys, pure=False)
         for future in dask_completed(futures):  # type: ignore[no-untyped-call]
-            yield future.result()
+            try:
+                yield future.result()
+            except Exception as error:  # the run's worker was lost too often (KilledWorker)
+                if client.status != "running":
+                    raise WorkerError(
+                        f"--scheduler {scheduler}: lost the Dask cluster ({error})"
+                    ) from None
+                lost = f"worker lost: {type(error).__name__}: {error}"
+                yield failed(by_key[future.key], lost, 0.0)
     finally:
         client.close()  # type: ignore[no-untyped-call]
 
@@ -263,6 +280,8 @@ def run_study(
     Raises:
         ExportError: for a non-empty ``out`` without ``resume``.
         ConfigError: when resuming a different study, or an unreachable scheduler.
+        WorkerError: a local worker process died, or the Dask cluster went away; the
+            finished runs are kept (results.parquet included) for ``resume``.
     """
     out = Path(out)
     done = _prepare(spec, out, resume)
@@ -272,10 +291,17 @@ def run_study(
     if progress is not None:
         progress.begin(len(spec.runs()), len(done))
     outcomes = _dask(jobs, scheduler) if scheduler else _local(jobs, workers)
-    for outcome in outcomes:
-        _write_run(out, outcome)
-        if progress is not None:
-            progress(outcome)
+    try:
+        for outcome in outcomes:
+            _write_run(out, outcome)
+            if progress is not None:
+                progress(outcome)
+    except WorkerError as error:
+        finished = len(collect(spec, out))
+        raise WorkerError(
+            f"{spec.name}: {error}; the {finished} finished runs are kept in {out}: "
+            "continue with --resume"
+        ) from None
     results = collect(spec, out)
     if report and spec.report and len(results):
         from cosim.studies.reporting import report_study

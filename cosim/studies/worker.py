@@ -72,11 +72,17 @@ def _cell(value: Any) -> Any:
     return value
 
 
+def failed(job: Job, error: str, wall_time_s: float) -> Outcome:
+    """The outcome of a run that did not finish: its row says why."""
+    row: dict[str, Any] = {"run_id": job.run_id, "seed": job.seed}
+    row.update((key, _cell(value)) for key, value in job.overrides.items())
+    row.update(status="error", error=error, wall_time_s=round(wall_time_s, 4))
+    return Outcome(row, "", {}, {})
+
+
 def run_one(job: Job) -> Outcome:
     """Run one study run; failures come back as a row with status ``error``, never raise."""
     start = time.perf_counter()
-    row: dict[str, Any] = {"run_id": job.run_id, "seed": job.seed}
-    row.update((key, _cell(value)) for key, value in job.overrides.items())
     try:
         overrides = dict(job.overrides)
         overrides["scenario.seed"] = job.seed
@@ -85,18 +91,12 @@ def run_one(job: Job) -> Outcome:
         scenario = load_scenario(job.scenario, overrides, override_origin="study")
         result = execute(scenario)
     except CosimError as error:
-        row.update(
-            status="error", error=str(error), wall_time_s=round(time.perf_counter() - start, 4)
-        )
-        return Outcome(row, "", {}, {})
+        return failed(job, str(error), time.perf_counter() - start)
     except Exception as error:  # a bug in a run must not stop the study
         detail = "".join(traceback.format_exception_only(type(error), error)).strip()
-        row.update(
-            status="error",
-            error=f"internal error: {detail}",
-            wall_time_s=round(time.perf_counter() - start, 4),
-        )
-        return Outcome(row, "", {}, {})
+        return failed(job, f"internal error: {detail}", time.perf_counter() - start)
+    row: dict[str, Any] = {"run_id": job.run_id, "seed": job.seed}
+    row.update((key, _cell(value)) for key, value in job.overrides.items())
     summary = result.summary
     for key, value in summary.items():
         if key not in ("scenario", "source", "seed"):

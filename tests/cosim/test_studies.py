@@ -7,9 +7,11 @@ import signal
 import subprocess
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
+import psutil
 import pytest
 
 import cosim
@@ -72,6 +74,12 @@ def test_results_are_identical_in_process_and_on_two_local_workers(tmp_path):
     assert (tmp_path / "two" / "runs" / "0003_s2" / "summary.json").exists()
 
 
+@dataclass
+class DaskCluster:
+    address: str
+    workers: list[subprocess.Popen[bytes]]  # the `dask worker` commands (nanny processes)
+
+
 @pytest.fixture
 def dask_cluster(tmp_path):
     """A real Dask scheduler and two workers, separate processes on loopback."""
@@ -127,7 +135,7 @@ def dask_cluster(tmp_path):
 
         with Client(address, timeout="30s") as client:
             client.wait_for_workers(2, timeout=60)
-        yield address
+        yield DaskCluster(address, procs[1:])
     finally:
         for proc in reversed(procs):
             proc.terminate()
@@ -142,7 +150,38 @@ def dask_cluster(tmp_path):
 def test_a_study_gives_the_same_rows_on_a_real_dask_cluster_as_locally(tmp_path, dask_cluster):
     spec = load_study(_study(tmp_path))
     local = run_study(spec, tmp_path / "local", workers=1)
-    remote = run_study(spec, tmp_path / "dask", scheduler=dask_cluster)
+    remote = run_study(spec, tmp_path / "dask", scheduler=dask_cluster.address)
+    assert set(remote["status"]) == {"ok"}
+    pd.testing.assert_frame_equal(_comparable(local), _comparable(remote))
+
+
+class _KillAfterFirstRun:
+    """A study progress that SIGKILLs some processes once the first run has finished."""
+
+    def __init__(self, victims) -> None:
+        self.victims = victims
+        self.killed: list[int] = []
+
+    def begin(self, total: int, already_done: int) -> None:
+        pass
+
+    def __call__(self, outcome: Outcome) -> None:
+        if not self.killed:
+            for process in self.victims():
+                process.send_signal(signal.SIGKILL)
+                self.killed.append(process.pid)
+
+
+@pytest.mark.slow
+def test_a_study_survives_a_dask_worker_killed_mid_way_with_the_same_rows(tmp_path, dask_cluster):
+    spec = load_study(_study(tmp_path))
+    # the worker process proper is the child of the `dask worker` nanny, which restarts it
+    killer = _KillAfterFirstRun(
+        lambda: psutil.Process(dask_cluster.workers[0].pid).children(recursive=True)[:1]
+    )
+    remote = run_study(spec, tmp_path / "dask", scheduler=dask_cluster.address, progress=killer)
+    assert killer.killed, "no dask worker process to kill"
+    local = run_study(spec, tmp_path / "local", workers=1)
     assert set(remote["status"]) == {"ok"}
     pd.testing.assert_frame_equal(_comparable(local), _comparable(remote))
 
@@ -180,6 +219,38 @@ def test_a_study_killed_mid_way_and_resumed_has_every_run_exactly_once(tmp_path)
     assert results["run_id"].is_unique
     assert not list(runs.glob("*.partial"))
     assert len(list(runs.iterdir())) == 8
+
+
+def test_a_local_worker_process_killed_stops_the_study_cleanly_and_resume_finishes_it(tmp_path):
+    path = _study(tmp_path, duration=40.0)
+    out = tmp_path / "out"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "cosim", "study", str(path), "--out", str(out), "--workers", "2"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and not [
+        p for p in (out / "runs").glob("*") if not p.name.endswith(".partial")
+    ]:
+        time.sleep(0.05)
+    # the pool's workers are the fork server's children, the study's grandchildren
+    study = psutil.Process(proc.pid)
+    workers = [p for p in study.children(recursive=True) if p.ppid() != proc.pid]
+    assert workers, "no worker process found"
+    workers[0].send_signal(signal.SIGKILL)
+    _, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == 2, stderr
+    last = stderr.strip().splitlines()[-1]
+    assert last.startswith("cosim: error: tiny: a worker process died"), stderr
+    assert "continue with --resume" in last and "Traceback" not in stderr
+    kept = pd.read_parquet(out / "results.parquet")
+    assert 1 <= len(kept) < 8 and set(kept["status"]) == {"ok"}
+    resumed = cli("study", str(path), "--out", str(out), "--resume", "--workers", "2")
+    assert resumed.returncode == 0, resumed.stderr
+    results = pd.read_parquet(out / "results.parquet")
+    assert len(results) == 8 and results["run_id"].is_unique and set(results["status"]) == {"ok"}
 
 
 def test_a_failing_run_is_recorded_and_the_others_go_on(tmp_path):
