@@ -136,7 +136,21 @@ class DtaAdapter:
             bus.subscribe(order_topic(robot.name), host, on)
             bus.subscribe(topic(robot.name, "nav/status"), host, on)
             bus.subscribe(topic(robot.name, "odom"), host, on)
-        run.kernel.every(self.period_ns, lambda now: self._round(run, now), stage=Stage.CONTROL)
+        if self.cfg.round_phase == "aligned":
+            run.kernel.every(self.period_ns, lambda now: self._round(run, now), stage=Stage.CONTROL)
+        else:
+            # independent timers: each robot's rounds start at its own phase of the period, so
+            # a message arrives a varying time before the receiver's next round and latency
+            # below one period still delays convergence (it would not with aligned timers)
+            phases = run.rng.stream("dta.round_phase").integers(0, self.period_ns, len(self.robots))
+            now_ns = run.kernel.now_ns
+            for robot, host, phase in zip(self.robots, self.hosts, phases, strict=True):
+                run.kernel.every(
+                    self.period_ns,
+                    self._robot_round(run, robot, host),
+                    stage=Stage.CONTROL,
+                    start_ns=now_ns + int(phase),
+                )
         if self.cfg.protocol == "hungarian":
             run.kernel.every(s_to_ns(1.0), lambda now: self._report(run, now), stage=Stage.CONTROL)
 
@@ -217,34 +231,44 @@ class DtaAdapter:
         return float(math.hypot(task.x_m - x, task.y_m - y))
 
     def _round(self, run: RunContext, now_ns: int) -> None:
-        rebroadcast = s_to_ns(self.cfg.rebroadcast_s)
+        """One round of every robot at the same instant (aligned timers)."""
         for robot, host in zip(self.robots, self.hosts, strict=True):
-            self._keep_promises(run, robot, now_ns)
-            protocol = robot.protocol
-            if protocol is None:
-                continue
-            inbox, robot.inbox = robot.inbox, []
-            was_decided = protocol.decided
-            message, changed = protocol.round(inbox, now_ns)
-            send = message is not None and (
-                changed or not was_decided or now_ns - robot.last_broadcast_ns >= rebroadcast
+            self._round_of(run, robot, host, now_ns)
+
+    def _robot_round(
+        self, run: RunContext, robot: RobotTasks, host: HostId
+    ) -> Callable[[int], None]:
+        return lambda now_ns: self._round_of(run, robot, host, now_ns)
+
+    def _round_of(self, run: RunContext, robot: RobotTasks, host: HostId, now_ns: int) -> None:
+        """One protocol round of ``robot``: keep its promises, step, broadcast, act."""
+        self._keep_promises(run, robot, now_ns)
+        protocol = robot.protocol
+        if protocol is None:
+            return
+        inbox, robot.inbox = robot.inbox, []
+        was_decided = protocol.decided
+        message, changed = protocol.round(inbox, now_ns)
+        rebroadcast = s_to_ns(self.cfg.rebroadcast_s)
+        send = message is not None and (
+            changed or not was_decided or now_ns - robot.last_broadcast_ns >= rebroadcast
+        )
+        if send and message is not None:
+            run.bus.publish(BASES if isinstance(message, SimplexBasis) else BIDS, message, host)
+            robot.last_broadcast_ns = now_ns
+        if not was_decided or changed:
+            self.records.round(
+                now_ns,
+                robot.index,
+                robot.epoch,
+                protocol,
+                changed,
+                message.size_bytes() if send and message else 0,
             )
-            if send and message is not None:
-                run.bus.publish(BASES if isinstance(message, SimplexBasis) else BIDS, message, host)
-                robot.last_broadcast_ns = now_ns
-            if not was_decided or changed:
-                self.records.round(
-                    now_ns,
-                    robot.index,
-                    robot.epoch,
-                    protocol,
-                    changed,
-                    message.size_bytes() if send and message else 0,
-                )
-            if protocol.decided and (not robot.acted or changed):
-                robot.acted = True
-                self.records.decided(robot.index, robot.epoch, now_ns, protocol)
-                self._act(run, robot, protocol.task())
+        if protocol.decided and (not robot.acted or changed):
+            robot.acted = True
+            self.records.decided(robot.index, robot.epoch, now_ns, protocol)
+            self._act(run, robot, protocol.task())
 
     # -- acting on a decision ------------------------------------------------------------------
     def _act(self, run: RunContext, robot: RobotTasks, index: int | None) -> None:

@@ -218,6 +218,11 @@ class AssignmentConfig:
         "the base station, nearest free task, or consensus-based auction (Choi et al. 2009)",
     )
     period_ms: float = param(100.0, "protocol round period (ms)", gt=0)
+    round_phase: Literal["independent", "aligned"] = param(
+        "independent",
+        "robots' round timers: each started at its own random phase within the period, as "
+        "timers on separate machines are, or all firing at the same instants",
+    )
     preemption: bool = param(
         False, "a robot heading to its task may be re-assigned by a later epoch"
     )

@@ -169,12 +169,34 @@ def test_the_same_seed_gives_the_same_tables_for_the_full_loop():
 
 
 def test_convergence_is_timed_from_the_announcement_so_more_latency_never_shortens_it():
-    # both latencies are below the 100 ms round period: the robots decide at the same round
-    # ticks, so timed from the announcement the convergence times are equal; timed from each
-    # robot's reception they would shrink by the extra latency
+    # with aligned timers and both latencies below the 100 ms round period, the robots decide
+    # at the same round ticks, so timed from the announcement the convergence times are
+    # equal; timed from each robot's reception they would shrink by the extra latency
     short, long = (
-        _run(**{"network.latency_ms": ms, "scenario.duration_s": 60.0}) for ms in (20.0, 60.0)
+        _run(
+            **{
+                "network.latency_ms": ms,
+                "scenario.duration_s": 60.0,
+                "assignment.round_phase": "aligned",
+            }
+        )
+        for ms in (20.0, 60.0)
     )
     assert short.summary["epochs"] >= 3
-    assert long.summary["mean_convergence_time_s"] >= short.summary["mean_convergence_time_s"]
+    assert long.summary["mean_convergence_time_s"] == short.summary["mean_convergence_time_s"]
     assert short.summary["mean_convergence_time_s"] > 0.02
+
+
+def test_with_independent_round_timers_latency_below_one_period_still_delays_convergence():
+    def convergence(phase: str, latency_ms: float) -> float:
+        result = _run(
+            **{
+                "network.latency_ms": latency_ms,
+                "scenario.duration_s": 60.0,
+                "assignment.round_phase": phase,
+            }
+        )
+        return float(result.summary["mean_convergence_time_s"])
+
+    assert convergence("aligned", 5.0) == convergence("aligned", 50.0)
+    assert convergence("independent", 50.0) > convergence("independent", 5.0) + 0.02
