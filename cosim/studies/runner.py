@@ -158,14 +158,19 @@ def _dask(jobs: list[Job], scheduler: str) -> Iterator[Outcome]:
         futures = client.map(run_one, jobs, key=keys, pure=False)
         for future in dask_completed(futures):  # type: ignore[no-untyped-call]
             try:
-                yield future.result()
+                outcome = future.result()
             except Exception as error:  # the run's worker was lost too often (KilledWorker)
                 if client.status != "running":
                     raise WorkerError(
                         f"--scheduler {scheduler}: lost the Dask cluster ({error})"
                     ) from None
-                lost = f"worker lost: {type(error).__name__}: {error}"
-                yield failed(by_key[future.key], lost, 0.0)
+                outcome = failed(
+                    by_key[future.key], f"worker lost: {type(error).__name__}: {error}", 0.0
+                )
+            # let the cluster forget the result: otherwise every run's tables stay in worker
+            # memory until the study ends, and a lost worker's finished runs are recomputed
+            future.release()
+            yield outcome
     finally:
         client.close()  # type: ignore[no-untyped-call]
 

@@ -175,10 +175,14 @@ class _KillAfterFirstRun:
 @pytest.mark.slow
 def test_a_study_survives_a_dask_worker_killed_mid_way_with_the_same_rows(tmp_path, dask_cluster):
     spec = load_study(_study(tmp_path))
-    # the worker process proper is the child of the `dask worker` nanny, which restarts it
-    killer = _KillAfterFirstRun(
-        lambda: psutil.Process(dask_cluster.workers[0].pid).children(recursive=True)[:1]
-    )
+
+    # the worker process proper is the nanny's spawned child (not its resource tracker);
+    # the nanny starts a new one
+    def worker_process():
+        nanny = psutil.Process(dask_cluster.workers[0].pid)
+        return [p for p in nanny.children() if "spawn_main" in " ".join(p.cmdline())]
+
+    killer = _KillAfterFirstRun(worker_process)
     remote = run_study(spec, tmp_path / "dask", scheduler=dask_cluster.address, progress=killer)
     assert killer.killed, "no dask worker process to kill"
     local = run_study(spec, tmp_path / "local", workers=1)
