@@ -23,7 +23,7 @@ import fcl
 import numpy as np
 import numpy.typing as npt
 
-FloatArray = npt.NDArray[np.float64]
+from models.arrays import FloatArray
 
 _HEIGHT_M = 1.0
 _Z_STEP_M = 1e-6

@@ -12,9 +12,8 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from models.arrays import FloatArray
 from models.kinematics import wrap_angle
-
-FloatArray = npt.NDArray[np.float64]
 
 
 @dataclass(frozen=True)

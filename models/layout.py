@@ -12,11 +12,9 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
-import numpy.typing as npt
 
+from models.arrays import FloatArray
 from models.errors import ModelError
-
-FloatArray = npt.NDArray[np.float64]
 
 DOCK_GAP_M = 0.3
 """Free gap between neighbouring robots in the dock (m)."""

@@ -8,9 +8,8 @@ registered, so that indices are stable within a run.
 from __future__ import annotations
 
 import numpy as np
-import numpy.typing as npt
 
-FloatArray = npt.NDArray[np.float64]
+from models.arrays import FloatArray
 
 
 class DynamicObstacles:

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import numpy.typing as npt
 
+from models.arrays import FloatArray, IntArray
 from models.errors import ModelError
 
 if TYPE_CHECKING:
@@ -33,8 +34,6 @@ _SNAP_CELLS = 1e-6
 """Box edges closer than this (in cells) to a cell boundary are taken to lie on it."""
 
 Int8Array = npt.NDArray[np.int8]
-IntArray = npt.NDArray[np.int64]
-FloatArray = npt.NDArray[np.float64]
 
 
 @dataclass(frozen=True, eq=False)

@@ -20,9 +20,8 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from models.arrays import FloatArray
 from models.kinematics import integrate
-
-FloatArray = npt.NDArray[np.float64]
 
 
 def drift_increments(

@@ -36,10 +36,8 @@ from typing import Any
 
 import numba
 import numpy as np
-import numpy.typing as npt
 
-FloatArray = npt.NDArray[np.float64]
-IntArray = npt.NDArray[np.int64]
+from models.arrays import FloatArray, IntArray
 
 _PAD_M = 1e-7
 """Growth of every item's shape when binned (m): far above the rounding of the walk,

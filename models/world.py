@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import numpy.typing as npt
 
+from models.arrays import FloatArray
 from models.errors import ModelError
 from models.layout import (
     DOCK_GAP_M,
@@ -25,8 +26,6 @@ from models.layout import (
     WarehouseSpec,
     place_shelves,
 )
-
-FloatArray = npt.NDArray[np.float64]
 
 
 @dataclass(frozen=True)

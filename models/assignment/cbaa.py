@@ -46,7 +46,6 @@ Properties (consistent scores: each agent's scores are fixed; Sec. III of the pa
 
 from __future__ import annotations
 
-from collections import deque
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import NamedTuple
@@ -54,10 +53,9 @@ from typing import NamedTuple
 import numpy as np
 import numpy.typing as npt
 
+from models.arrays import FloatArray, IntArray
 from models.assignment.greedy import Assignment, check_cost, greedy_global
-
-FloatArray = npt.NDArray[np.float64]
-IntArray = npt.NDArray[np.int64]
+from models.network.topology import hops_from
 
 NO_WINNER = -1
 
@@ -302,14 +300,7 @@ def graph_diameter(n_robots: int, edges: Iterable[tuple[int, int]]) -> tuple[lis
     neighbours = [sorted(s) for s in adjacent]
     longest = 0
     for start in range(n_robots):
-        hops = {start: 0}
-        frontier = deque([start])
-        while frontier:
-            here = frontier.popleft()
-            for there in neighbours[here]:
-                if there not in hops:
-                    hops[there] = hops[here] + 1
-                    frontier.append(there)
+        hops = hops_from(start, neighbours.__getitem__)
         if len(hops) < n_robots:
             raise ValueError(
                 f"the communication graph is not connected: robot {start} reaches"

@@ -20,7 +20,6 @@ tests and benchmarks.
 from __future__ import annotations
 
 import math
-from collections import deque
 from collections.abc import Iterable, Sequence
 from itertools import chain
 from typing import NamedTuple
@@ -37,6 +36,7 @@ from models.assignment.problem import (
 )
 from models.assignment.simplex import lex_simplex
 from models.errors import ModelError
+from models.network.topology import hops_from
 
 
 class SimplexAgent:
@@ -259,14 +259,7 @@ def graph_diameter(adjacent: Sequence[Sequence[int]]) -> int:
     """
     longest = 0
     for start in range(len(adjacent)):
-        hops = {start: 0}
-        frontier = deque([start])
-        while frontier:
-            here = frontier.popleft()
-            for there in adjacent[here]:
-                if there not in hops:
-                    hops[there] = hops[here] + 1
-                    frontier.append(there)
+        hops = hops_from(start, adjacent.__getitem__)
         if len(hops) < len(adjacent):
             raise ModelError("network.edges", "disconnected", "a connected graph of agents")
         longest = max(longest, max(hops.values()))

@@ -21,6 +21,8 @@ import numba
 import numpy as np
 import numpy.typing as npt
 
+from models.arrays import FloatArray, IntArray
+
 UNIT_ROUNDOFF = 2.0**-52
 """Twice the unit roundoff of float64: the error bound keeps a factor 2 of margin."""
 
@@ -29,9 +31,6 @@ CAP_HIT = -1
 
 UNBOUNDED = -2
 """Returned by the pivot loop when an entering column had no positive entry."""
-
-FloatArray = npt.NDArray[np.float64]
-IntArray = npt.NDArray[np.int64]
 
 
 def _exact_sign_py(

@@ -50,17 +50,14 @@ from collections.abc import Iterable, Sequence
 from typing import NamedTuple
 
 import numpy as np
-import numpy.typing as npt
 
+from models.arrays import FloatArray, IntArray
 from models.assignment.pivoting import CAP_HIT, UNBOUNDED, pivot_loop
 from models.assignment.problem import Column, ColumnKind, LpShape
 from models.errors import ModelError
 
 _EXACT_INTEGER_SUM = 2.0**52
 """Integer costs whose magnitudes sum below this add up exactly in float64."""
-
-FloatArray = npt.NDArray[np.float64]
-IntArray = npt.NDArray[np.int64]
 
 
 class Solution(NamedTuple):

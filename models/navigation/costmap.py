@@ -34,6 +34,7 @@ import numpy as np
 import numpy.typing as npt
 from scipy import ndimage
 
+from models.arrays import FloatArray, IntArray, UInt8Array
 from models.errors import ModelError
 from models.occupancy import OccupancyGrid
 
@@ -51,10 +52,7 @@ FREE = 0
 _RADIUS_TOL_M = 1e-9
 """Tolerance (m) on radius comparisons, so cells exactly on a radius count as inside."""
 
-UInt8Array = npt.NDArray[np.uint8]
 Float32Array = npt.NDArray[np.float32]
-FloatArray = npt.NDArray[np.float64]
-IntArray = npt.NDArray[np.int64]
 
 
 @dataclass(frozen=True)

@@ -16,8 +16,7 @@ import numba
 import numpy as np
 import numpy.typing as npt
 
-FloatArray = npt.NDArray[np.float64]
-IntArray = npt.NDArray[np.int64]
+from models.arrays import FloatArray, IntArray
 
 SEARCH_SEGMENTS = 8
 """Segments ahead of the last one searched when projecting (bounds the work per robot)."""

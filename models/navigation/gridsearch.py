@@ -24,10 +24,8 @@ import numba
 import numpy as np
 import numpy.typing as npt
 
+from models.arrays import IntArray, UInt8Array
 from models.navigation.costmap import MAX_NON_OBSTACLE
-
-UInt8Array = npt.NDArray[np.uint8]
-IntArray = npt.NDArray[np.int64]
 
 SQRT2 = math.sqrt(2.0)
 """Length of a diagonal step (cells)."""

@@ -28,15 +28,11 @@ from dataclasses import dataclass
 from enum import StrEnum
 
 import numpy as np
-import numpy.typing as npt
 
+from models.arrays import FloatArray, IntArray, UInt8Array
 from models.errors import ModelError
 from models.navigation.costmap import INSCRIBED, NO_INFORMATION, StaticCostmap
 from models.navigation.gridsearch import DX, DY, SQRT2, astar, escape_r2, prune, readonly
-
-UInt8Array = npt.NDArray[np.uint8]
-FloatArray = npt.NDArray[np.float64]
-IntArray = npt.NDArray[np.int64]
 
 
 @dataclass(frozen=True, eq=False)

@@ -20,9 +20,7 @@ from typing import NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-FloatArray = npt.NDArray[np.float64]
-IntArray = npt.NDArray[np.int64]
-BoolArray = npt.NDArray[np.bool_]
+from models.arrays import BoolArray, FloatArray, IntArray
 
 
 class MovingPoints(NamedTuple):

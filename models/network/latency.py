@@ -21,10 +21,8 @@ import numpy as np
 import numpy.typing as npt
 from scipy.special import ndtr
 
+from models.arrays import FloatArray, IntArray
 from models.errors import ModelError
-
-IntArray = npt.NDArray[np.int64]
-FloatArray = npt.NDArray[np.float64]
 
 NS_PER_MS = 1_000_000
 LATENCY_KEY = "network.latency_ms"

@@ -38,9 +38,8 @@ import numpy as np
 import numpy.typing as npt
 from scipy.special import ndtr
 
+from models.arrays import FloatArray
 from models.errors import ModelError
-
-FloatArray = npt.NDArray[np.float64]
 
 SPEED_OF_LIGHT_MPS = 299_792_458.0
 REFERENCE_DISTANCE_M = 1.0

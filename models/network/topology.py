@@ -10,13 +10,16 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Hashable, Iterable, Sequence
+from typing import TypeVar
 
 import numpy as np
 import numpy.typing as npt
 
 from models.errors import ModelError
 from models.network.loss import check_probability
+
+N = TypeVar("N", bound=Hashable)
 
 Edge = tuple[str, str]
 Edges = frozenset[Edge]
@@ -133,12 +136,18 @@ def _adjacency(names: Sequence[str], edges: Edges) -> dict[str, list[str]]:
     return adjacent
 
 
-def _hops_from(start: str, adjacent: dict[str, list[str]]) -> dict[str, int]:
+def hops_from(start: N, neighbours: Callable[[N], Iterable[N]]) -> dict[N, int]:
+    """Hop counts from ``start`` to every node it reaches (breadth-first search).
+
+    Args:
+        start: the first node.
+        neighbours: a node's neighbours, e.g. ``adjacency.__getitem__``.
+    """
     hops = {start: 0}
     frontier = deque([start])
     while frontier:
         here = frontier.popleft()
-        for there in adjacent[here]:
+        for there in neighbours(here):
             if there not in hops:
                 hops[there] = hops[here] + 1
                 frontier.append(there)
@@ -152,7 +161,7 @@ def is_connected(names: Sequence[str], edges: Edges) -> bool:
     """
     if len(names) < 2:
         return True
-    return len(_hops_from(names[0], _adjacency(names, edges))) == len(set(names))
+    return len(hops_from(names[0], _adjacency(names, edges).__getitem__)) == len(set(names))
 
 
 def diameter(names: Sequence[str], edges: Edges) -> float:
@@ -160,7 +169,7 @@ def diameter(names: Sequence[str], edges: Edges) -> float:
     adjacent = _adjacency(names, edges)
     longest = 0
     for name in adjacent:
-        hops = _hops_from(name, adjacent)
+        hops = hops_from(name, adjacent.__getitem__)
         if len(hops) < len(adjacent):
             return math.inf
         longest = max(longest, max(hops.values()))
