@@ -103,6 +103,27 @@ def _bin_py(
     return start, items
 
 
+def _circle_t_py(
+    ox: float, oy: float, dx: float, dy: float, cx: float, cy: float, radius: float
+) -> float:
+    """Distance along the unit ray (ox, oy) + t (dx, dy) to a circle's boundary, or inf.
+
+    From outside the circle, the near crossing; from inside, the far one (a robot's own
+    footprint is excluded by id, but a ray may start inside another's).
+    """
+    fx, fy = ox - cx, oy - cy
+    hb = fx * dx + fy * dy
+    c = fx * fx + fy * fy - radius * radius
+    disc = hb * hb - c
+    if disc < 0.0:
+        return np.inf
+    t = -hb - math.sqrt(disc) if c > 0.0 else -hb + math.sqrt(disc)
+    return t if t >= 0.0 else np.inf
+
+
+_circle_t: Any = numba.njit(cache=True, fastmath=False, inline="always")(_circle_t_py)
+
+
 def _cast_py(
     origins: FloatArray,
     cos_yaw: FloatArray,
@@ -136,16 +157,9 @@ def _cast_py(
             dy = s_yaw * cos_beam[b] + c_yaw * sin_beam[b]
             best = inf
             for k in range(spill.shape[0]):
-                if spill_ids[k] == own:
-                    continue
-                fx, fy = ox - spill[k, 0], oy - spill[k, 1]
-                hb = fx * dx + fy * dy
-                c = fx * fx + fy * fy - spill[k, 2] * spill[k, 2]
-                disc = hb * hb - c
-                if disc >= 0.0:
-                    t = -hb - math.sqrt(disc) if c > 0.0 else -hb + math.sqrt(disc)
-                    if t >= 0.0 and t < best:
-                        best = t
+                if spill_ids[k] != own:
+                    t = _circle_t(ox, oy, dx, dy, spill[k, 0], spill[k, 1], spill[k, 2])
+                    best = min(best, t)
             # clip the ray to the grid (slabs) to find the first cell it visits
             t_in, t_out = 0.0, range_max
             if dx != 0.0:
@@ -186,16 +200,9 @@ def _cast_py(
                             if u >= 0.0 and u <= 1.0:
                                 best = t
                     for k in range(circ_start[cid], circ_start[cid + 1]):
-                        if circ_ids[k] == own:
-                            continue
-                        fx, fy = ox - circs[k, 0], oy - circs[k, 1]
-                        hb = fx * dx + fy * dy
-                        c = fx * fx + fy * fy - circs[k, 2] * circs[k, 2]
-                        disc = hb * hb - c
-                        if disc >= 0.0:
-                            t = -hb - math.sqrt(disc) if c > 0.0 else -hb + math.sqrt(disc)
-                            if t >= 0.0 and t < best:
-                                best = t
+                        if circ_ids[k] != own:
+                            t = _circle_t(ox, oy, dx, dy, circs[k, 0], circs[k, 1], circs[k, 2])
+                            best = min(best, t)
                     t_exit = min(tmx, tmy)
                     if best <= t_exit or t_exit > range_max:
                         break
