@@ -115,6 +115,7 @@ class DtaAdapter:
         bound = self.cfg.diameter_bound or diameter(robots, edges)
         self.diameter = int(bound) if math.isfinite(bound) else len(robots) - 1
         self.period_ns = period_ns(1000.0 / self.cfg.period_ms)
+        self.rebroadcast_ns = s_to_ns(self.cfg.rebroadcast_s)
         # a common bid reward above any travel cost in the hall (paths included)
         width, height = run.service(Warehouse).size_m
         self.reward_m = 10.0 * float(math.hypot(width, height))
@@ -144,10 +145,10 @@ class DtaAdapter:
             # below one period still delays convergence (it would not with aligned timers)
             phases = run.rng.stream("dta.round_phase").integers(0, self.period_ns, len(self.robots))
             now_ns = run.kernel.now_ns
-            for robot, host, phase in zip(self.robots, self.hosts, phases, strict=True):
+            for robot, phase in zip(self.robots, phases, strict=True):
                 run.kernel.every(
                     self.period_ns,
-                    self._robot_round(run, robot, host),
+                    self._robot_round(run, robot),
                     stage=Stage.CONTROL,
                     start_ns=now_ns + int(phase),
                 )
@@ -232,15 +233,13 @@ class DtaAdapter:
 
     def _round(self, run: RunContext, now_ns: int) -> None:
         """One round of every robot at the same instant (aligned timers)."""
-        for robot, host in zip(self.robots, self.hosts, strict=True):
-            self._round_of(run, robot, host, now_ns)
+        for robot in self.robots:
+            self._round_of(run, robot, now_ns)
 
-    def _robot_round(
-        self, run: RunContext, robot: RobotTasks, host: HostId
-    ) -> Callable[[int], None]:
-        return lambda now_ns: self._round_of(run, robot, host, now_ns)
+    def _robot_round(self, run: RunContext, robot: RobotTasks) -> Callable[[int], None]:
+        return lambda now_ns: self._round_of(run, robot, now_ns)
 
-    def _round_of(self, run: RunContext, robot: RobotTasks, host: HostId, now_ns: int) -> None:
+    def _round_of(self, run: RunContext, robot: RobotTasks, now_ns: int) -> None:
         """One protocol round of ``robot``: keep its promises, step, broadcast, act."""
         self._keep_promises(run, robot, now_ns)
         protocol = robot.protocol
@@ -249,11 +248,11 @@ class DtaAdapter:
         inbox, robot.inbox = robot.inbox, []
         was_decided = protocol.decided
         message, changed = protocol.round(inbox, now_ns)
-        rebroadcast = s_to_ns(self.cfg.rebroadcast_s)
         send = message is not None and (
-            changed or not was_decided or now_ns - robot.last_broadcast_ns >= rebroadcast
+            changed or not was_decided or now_ns - robot.last_broadcast_ns >= self.rebroadcast_ns
         )
         if send and message is not None:
+            host = self.hosts[robot.index]
             run.bus.publish(BASES if isinstance(message, SimplexBasis) else BIDS, message, host)
             robot.last_broadcast_ns = now_ns
         if not was_decided or changed:
@@ -325,9 +324,7 @@ class DtaAdapter:
         """Repeat claims while holding a task; retry requests and reports; end dwells."""
         host = self.hosts[robot.index]
         due = now_ns - robot.last_sent_ns >= s_to_ns(RETRY_S)
-        if robot.phase == "heading" and now_ns - robot.last_sent_ns >= s_to_ns(
-            self.cfg.rebroadcast_s
-        ):
+        if robot.phase == "heading" and now_ns - robot.last_sent_ns >= self.rebroadcast_ns:
             self._claim(run, robot, now_ns)
         elif robot.phase == "requesting" and due:
             robot.last_sent_ns = now_ns
