@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from adapters.lidar import SCENE_CELL_M
+from adapters.sensing.lidar import SCENE_CELL_M
 from models.errors import ModelError
 from models.lidar import cast_reference
 from models.raycast import StaticScene, cast_batch

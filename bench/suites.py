@@ -228,12 +228,12 @@ class Chatter:
 
 
 BREAKDOWN = {
-    "lidar (cast, noise, scan messages)": ("adapters/lidar.py", "_scan"),
-    "navigation control tick (all below)": ("adapters/navigation.py", "_control"),
-    "  global planning (A*, costmap, memory)": ("adapters/navigation.py", "_plan"),
+    "lidar (cast, noise, scan messages)": ("adapters/sensing/lidar.py", "_scan"),
+    "navigation control tick (all below)": ("adapters/navigation/stack.py", "_control"),
+    "  global planning (A*, costmap, memory)": ("adapters/navigation/stack.py", "_plan"),
     "  local control (DWA kernel)": ("models/navigation/dwa.py", "dwa_batch"),
-    "physics tick (kinematics, collisions, odometry)": ("adapters/fleet.py", "_tick"),
-    "  collision checks": ("adapters/collisions.py", "guard"),
+    "physics tick (kinematics, collisions, odometry)": ("adapters/fleet/motion.py", "_tick"),
+    "  collision checks": ("adapters/fleet/collisions.py", "guard"),
     "bus publish (all messages)": ("cosim/bus.py", "publish"),
 }
 

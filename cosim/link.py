@@ -1,7 +1,7 @@
 """The link between hosts: decides if and when a message reaches another host.
 
 The bus hands every inter-host transmission to a :class:`Link`. The ideal link delivers
-at once; the network model (``adapters.network``) decides with latency, loss, bandwidth,
+at once; the network model (``adapters.network.link``) decides with latency, loss, bandwidth,
 range and partitions.
 """
 

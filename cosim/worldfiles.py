@@ -57,7 +57,7 @@ WALL_HEIGHT_M = 2.5
 SHELF_HEIGHT_M = 2.0
 """Height of the shelves in SDF worlds (m)."""
 WORLD_STREAM = "world"
-"""Random stream the world adapter generates the warehouse from (adapters.world)."""
+"""Random stream the world adapter generates the warehouse from (adapters.world.warehouse)."""
 
 
 def _write(path: Path, content: bytes) -> Path:
@@ -313,13 +313,13 @@ def write_sdf(warehouse: Warehouse, sdf_path: Path, *, world_name: str = "wareho
 def scenario_warehouse(scenario: Scenario) -> Warehouse:
     """The warehouse a run of ``scenario`` builds, without running anything.
 
-    Same spec, same seed and same random stream as :func:`adapters.world.build_warehouse`,
+    Same spec, same seed and same random stream as :func:`adapters.world.warehouse.build_warehouse`,
     so the world is identical to the run's.
 
     Raises:
         ScenarioError: naming the scenario and key for impossible requests.
     """
-    from adapters.world import spec_from_scenario  # the shell may import adapters
+    from adapters.world.warehouse import spec_from_scenario  # the shell may import adapters
 
     try:
         return generate_warehouse(

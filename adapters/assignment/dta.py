@@ -22,9 +22,14 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from adapters.dta_protocols import AssignmentProtocol, CbbaProtocol, GreedyProtocol, SimplexProtocol
-from adapters.dta_records import DtaRecords
-from adapters.dta_topics import (
+from adapters.assignment.protocols import (
+    AssignmentProtocol,
+    CbbaProtocol,
+    GreedyProtocol,
+    SimplexProtocol,
+)
+from adapters.assignment.records import DtaRecords
+from adapters.assignment.topics import (
     BASES,
     BIDS,
     CLAIMS,
@@ -36,7 +41,7 @@ from adapters.dta_topics import (
     reply_topic,
 )
 from adapters.naming import topic
-from adapters.network import NetworkView
+from adapters.network.link import NetworkView
 from cosim.adapter import RunContext
 from cosim.bus import Envelope
 from cosim.hosts import HostId

@@ -17,7 +17,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from adapters.network_setup import build_model, build_topology, partitions_of
+from adapters.network.setup import build_model, build_topology, partitions_of
 from cosim.adapter import RunContext
 from cosim.errors import ConfigError
 from cosim.hosts import HostId, HostKind

@@ -16,7 +16,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from adapters.fleet import FleetAdapter
+from adapters.fleet.motion import FleetAdapter
 from cosim.adapter import RunContext
 from cosim.timebase import NS_PER_S
 from models.collision import CollisionChecker, OtherKind, Proximity

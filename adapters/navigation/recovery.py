@@ -13,7 +13,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from adapters.scan_memory import ScanMemory
+from adapters.navigation.scan_memory import ScanMemory
 from cosim.timebase import s_to_ns
 from models.kinematics import DriveLimits
 

@@ -18,7 +18,7 @@ from typing import Any, ClassVar
 import numpy as np
 from scipy import ndimage
 
-from adapters.dta_topics import (
+from adapters.assignment.topics import (
     CLAIMS,
     DONE,
     REPORTS,

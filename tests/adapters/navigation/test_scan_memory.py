@@ -3,7 +3,7 @@ import math
 import numpy as np
 import pytest
 
-from adapters.scan_memory import MovingMemory, ScanMemory
+from adapters.navigation.scan_memory import MovingMemory, ScanMemory
 
 ANGLES = -math.pi + 2 * math.pi / 8 * np.arange(8)  # every 45 deg, beam 4 looks ahead
 

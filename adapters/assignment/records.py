@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from adapters.dta_protocols import AssignmentProtocol
+from adapters.assignment.protocols import AssignmentProtocol
 from cosim.records import Recorder
 from cosim.timebase import NS_PER_S
 from models.assignment.problem import AssignmentProblem, hungarian, objective

@@ -25,11 +25,11 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from adapters.fleet import drive_limits
+from adapters.fleet.motion import drive_limits
 from adapters.naming import topic
-from adapters.nav_records import NavRecords
-from adapters.nav_recovery import Recovery
-from adapters.scan_memory import MovingMemory, ScanMemory
+from adapters.navigation.records import NavRecords
+from adapters.navigation.recovery import Recovery
+from adapters.navigation.scan_memory import MovingMemory, ScanMemory
 from cosim.adapter import RunContext
 from cosim.bus import Envelope
 from cosim.errors import ConfigError

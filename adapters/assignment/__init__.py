@@ -1,0 +1,1 @@
+"""Dynamic task assignment on the robots (the ChoiRbot role): protocols, records, topics."""

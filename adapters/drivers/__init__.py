@@ -1,0 +1,1 @@
+"""Simple robot software without navigation: line-of-sight waypoints, wandering."""

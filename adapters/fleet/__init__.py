@@ -1,0 +1,1 @@
+"""The robots' bodies: batched kinematics and odometry, ground-truth contacts."""

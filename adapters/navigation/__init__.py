@@ -1,0 +1,1 @@
+"""The Nav2 role on every robot: planning, control, recovery, and random goals."""

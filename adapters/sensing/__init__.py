@@ -1,0 +1,1 @@
+"""Sensors sampling the ground truth: the batched lidar."""

@@ -1,0 +1,1 @@
+"""The task source on the base station: tasks created, announced, granted and closed."""
