@@ -27,6 +27,8 @@ FIGURES_DIR = "figures"
 ERRORS_LISTED = 5  # failed runs quoted in a report; the others are only counted
 DPI = 150
 MARKERS = "osD^v<>pPXh*"
+PANELS_PER_ROW = 3
+"""Facet panels per row of a figure; more values wrap onto further rows."""
 _BAND = ("mean", "ci_low", "ci_high")
 
 
@@ -129,11 +131,12 @@ def metric_figure(
         elif logx:  # symlog: linear up to the smallest positive x (0 can stay), log beyond
             positive = ok[x][ok[x] > 0]
             ax.set_xscale("symlog", linthresh=float(positive.min()) if len(positive) else 1.0)
-        ax.set_xlabel(x)
         ax.grid(True, alpha=0.3)
-    axes[0].set_ylabel(metric)
-    if hue:
-        axes[-1].legend(title=hue, fontsize=8)
+    _label_axes(axes, x, metric)
+    if hue:  # beside the first row, where it covers no data
+        axes[min(len(axes), PANELS_PER_ROW) - 1].legend(
+            title=hue, fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0)
+        )
     figure.suptitle(title or f"{metric} vs {x}")
     return figure
 
@@ -198,8 +201,7 @@ def heatmap(
                 ax.text(j, i, f"{value:.3g}", ha="center", va="center", fontsize=8, color=color)
         ax.set_xticks(range(len(x_levels)), [_label(v) for v in x_levels])
         ax.set_yticks(range(len(y_levels)), [_label(v) for v in y_levels])
-        ax.set_xlabel(x)
-    axes[0].set_ylabel(y)
+    _label_axes(axes, x, y)
     figure.colorbar(image, ax=axes, label=f"{metric} (mean over seeds)")
     figure.suptitle(title or f"{metric} over {x} and {y}")
     return _save(figure, Path(out))
@@ -338,13 +340,34 @@ def _plot_stats(
 def _panels(
     stats: pd.DataFrame, facet: str | None, *, width_in: float
 ) -> tuple[list[object], Figure, list[Axes]]:
+    """A panel per facet value, wrapped into rows of at most :data:`PANELS_PER_ROW`.
+
+    The panels share the y axis; unused cells of the last row are removed, so the axes
+    returned (in row-major order) are exactly one per facet value.
+    """
     facets: list[object] = _levels(stats[facet]) if facet else [None]
-    figure = Figure(figsize=(width_in * len(facets) + 1.0, 4.2), layout="constrained")
-    axes = list(figure.subplots(1, len(facets), sharey=True, squeeze=False)[0])
+    cols = min(len(facets), PANELS_PER_ROW)
+    rows = -(-len(facets) // cols)
+    figure = Figure(figsize=(width_in * cols + 1.0, 3.8 * rows + 0.5), layout="constrained")
+    grid = figure.subplots(rows, cols, sharey=True, squeeze=False)
+    cells: list[Axes] = list(grid.flat)
+    for ax in cells[len(facets) :]:
+        figure.delaxes(ax)
+    axes = cells[: len(facets)]
     for ax, value in zip(axes, facets, strict=True):
         if facet:
             ax.set_title(f"{facet} = {_label(value)}", fontsize=10)
     return facets, figure, axes
+
+
+def _label_axes(axes: list[Axes], x: str, y: str) -> None:
+    """Label x under the panels with none below them, y left of each row of :func:`_panels`."""
+    cols = min(len(axes), PANELS_PER_ROW)
+    for k, ax in enumerate(axes):
+        if k + cols >= len(axes):
+            ax.set_xlabel(x)
+        if k % cols == 0:
+            ax.set_ylabel(y)
 
 
 def _save(figure: Figure, path: Path) -> Path:

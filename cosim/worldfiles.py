@@ -31,7 +31,7 @@ import numpy.typing as npt
 import yaml
 
 from cosim.errors import ConfigError, ExportError, ScenarioError
-from cosim.figures import world_figure
+from cosim.plotting.world import world_figure
 from cosim.rng import RngStreams
 from cosim.scenario.model import Scenario
 from models.errors import ModelError

@@ -8,7 +8,7 @@ import yaml
 import cosim
 from cosim.assembly import assemble
 from cosim.errors import ConfigError, ExportError, ScenarioError
-from cosim.figures import world_figure
+from cosim.plotting.world import world_figure
 from cosim.worldfiles import (
     FREE_THRESH,
     OCCUPIED_THRESH,
