@@ -10,5 +10,5 @@ grouped by capability, mirroring ``models/``:
 - ``navigation/``: planning, control and recovery (the Nav2 role), random goals;
 - ``assignment/`` and ``tasks/``: dynamic task assignment and the task source;
 - ``drivers/``: simple robot software (waypoints, wander);
-- ``recording/``: ground-truth samples for the tables.
+- ``recording/``: ground-truth samples for the tables, the ROS interface for bags.
 """

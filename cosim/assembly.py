@@ -22,8 +22,11 @@ DRIVERS: dict[str, list[str]] = {
 """The adapters that make up each ``robots.driver``."""
 
 
-def adapter_names(scenario: Scenario) -> list[str]:
+def adapter_names(scenario: Scenario, *, recording: bool = False) -> list[str]:
     """The adapters a scenario runs, before requirements are resolved.
+
+    ``recording`` adds the ROS interface (clock, frames, map, markers) that bags and the
+    live view carry; it changes no table.
 
     Raises:
         ConfigError: for combinations that cannot work (a lidar-driven behaviour without
@@ -39,6 +42,8 @@ def adapter_names(scenario: Scenario) -> list[str]:
     if scenario.lidar.beams > 0:
         names.append("lidar")
     names += DRIVERS[driver] + ["poses"]
+    if recording:
+        names.append("ros_interface")
     names += [name for name in scenario.scenario.adapters if name not in names]
     return names
 
@@ -57,6 +62,8 @@ def assemble(
     names: list[str] | None = None,
     registry: AdapterRegistry | None = None,
     realtime: bool = False,
+    speed: float = 1.0,
+    recording: bool = False,
 ) -> Assembly:
     """Build the run context and construct the scenario's adapters.
 
@@ -65,10 +72,14 @@ def assemble(
         names: adapters to run instead of :func:`adapter_names` (requirements are added).
         registry: the adapter registry; defaults to the installed entry points.
         realtime: pace the kernel against the wall clock.
+        speed: simulated seconds per wall-clock second when ``realtime``.
+        recording: the run is recorded or viewed live (see :func:`adapter_names`).
     """
     registry = registry or AdapterRegistry.from_entry_points()
-    ordered = registry.resolve(names if names is not None else adapter_names(scenario))
-    kernel = Kernel(realtime=realtime)
+    if names is None:
+        names = adapter_names(scenario, recording=recording)
+    ordered = registry.resolve(names)
+    kernel = Kernel(realtime=realtime, speed=speed)
     recorder = Recorder(record_messages=scenario.record.messages)
     bus = Bus(kernel, tap=recorder)
     run = RunContext(

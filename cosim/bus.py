@@ -6,11 +6,18 @@ once (synchronously, in subscription order) and a subscriber on host B through t
 crosses the link once per destination host, however many subscribers that host has.
 Every local delivery, remote delivery and drop is reported to the bus's tap (the
 recorder).
+
+Publishers *advertise* their topics with the message type and QoS, as a ROS 2 node
+creates a publisher; recorders and the live view learn from the advertisements what a
+run will publish before it starts. A *monitor* sees every publication on a topic as it
+is published, like a bag recorder on the publishing host: it is neither a subscriber nor
+a host, so it adds no delivery, no network traffic and no row to any table.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
+from enum import StrEnum
 from typing import NamedTuple, Protocol
 
 import simpy
@@ -38,6 +45,37 @@ class Envelope(NamedTuple):
 
 
 Callback = Callable[[Message, Envelope], None]
+Monitor = Callable[[str, Message, HostId, int], None]
+"""Sees a publication: (topic, message, publishing host, publication time in ns)."""
+
+
+class TopicQos(StrEnum):
+    """The quality of service a topic is offered with (ROS 2's profiles for such topics).
+
+    The bag records it (rosbag2's ``offered_qos_profiles``); the live view re-sends the
+    last message of a latched topic to a viewer that subscribes late.
+    """
+
+    DEFAULT = "default"
+    """Reliable, volatile, keep last 10 (rclcpp's default profile)."""
+    SENSOR = "sensor"
+    """Best effort, volatile, keep last 5 (``rmw_qos_profile_sensor_data``)."""
+    LATCHED = "latched"
+    """Reliable, transient local, keep last 1 (``/tf_static``, ``/map``)."""
+
+
+class Advertisement(NamedTuple):
+    """What is published on a topic.
+
+    Attributes:
+        topic: topic name.
+        message_type: the message class published on it.
+        qos: how it is offered.
+    """
+
+    topic: str
+    message_type: type[Message]
+    qos: TopicQos
 
 
 class BusTap(Protocol):
@@ -57,8 +95,8 @@ class BusTap(Protocol):
         ...
 
 
-Route = tuple[tuple[Callback, ...], tuple[HostId, ...]]
-"""For one topic and publishing host: the local callbacks and the remote hosts."""
+Route = tuple[tuple[Callback, ...], tuple[HostId, ...], tuple[Monitor, ...]]
+"""For one topic and publishing host: the local callbacks, the remote hosts, the monitors."""
 
 
 class Bus:
@@ -76,7 +114,41 @@ class Bus:
         self.tap = tap
         self._topics: dict[str, dict[HostId, list[Callback]]] = {}
         self._routes: dict[tuple[str, HostId], Route] = {}
+        self._monitors: dict[str, list[Monitor]] = {}
+        self._advertised: dict[str, Advertisement] = {}
         self.published = 0
+
+    def advertise(
+        self, topic: str, message_type: type[Message], qos: TopicQos = TopicQos.DEFAULT
+    ) -> None:
+        """Declare that ``message_type`` messages are published on ``topic``.
+
+        Several publishers may advertise one topic (every robot's claims) with the same
+        type and QoS.
+
+        Raises:
+            ValueError: if ``topic`` is advertised already with another type or QoS.
+        """
+        ad = Advertisement(topic, message_type, qos)
+        known = self._advertised.setdefault(topic, ad)
+        if known != ad:
+            raise ValueError(
+                f"topic {topic!r} is advertised as {known.message_type.__name__} ({known.qos}); "
+                f"cannot advertise it as {message_type.__name__} ({qos})"
+            )
+
+    def advertised(self) -> Mapping[str, Advertisement]:
+        """Advertised topics, in advertisement order."""
+        return dict(self._advertised)
+
+    def monitor(self, topic: str, monitor: Monitor) -> None:
+        """Call ``monitor(topic, message, src, t_ns)`` for every publication on ``topic``.
+
+        Monitors run at publication, before any subscriber on the publishing host; they
+        see messages whether or not anything subscribes, and change nothing.
+        """
+        self._monitors.setdefault(topic, []).append(monitor)
+        self._routes.clear()
 
     def subscribe(self, topic: str, host: HostId, callback: Callback) -> None:
         """Call ``callback(message, envelope)`` for every message on ``topic`` reaching ``host``."""
@@ -91,21 +163,25 @@ class Bus:
         by_host = self._topics.get(topic, {})
         local = tuple(by_host.get(src, ()))
         remote = tuple(host for host in by_host if host != src)
-        route = (local, remote)
+        route = (local, remote, tuple(self._monitors.get(topic, ())))
         self._routes[(topic, src)] = route
         return route
 
     def publish(self, topic: str, message: Message, src: HostId) -> None:
         """Publish ``message`` on ``topic`` from host ``src`` at the current time.
 
-        Remote hosts are handed to the link first (their deliveries are scheduled), then
-        local subscribers are called at once, in subscription order.
+        Monitors see it first; remote hosts are handed to the link next (their deliveries
+        are scheduled), then local subscribers are called at once, in subscription order.
         """
         self.published += 1
         route = self._routes.get((topic, src))
         if route is None:
             route = self._route(topic, src)
-        local, remote = route
+        local, remote, monitors = route
+        if monitors:
+            t_ns = int(self.kernel.env.now)
+            for monitor in monitors:
+                monitor(topic, message, src, t_ns)
         if not local and not remote:
             return
         now = int(self.kernel.env.now)

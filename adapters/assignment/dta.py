@@ -30,6 +30,7 @@ from adapters.assignment.protocols import (
 )
 from adapters.assignment.records import DtaRecords
 from adapters.assignment.topics import (
+    ASSIGNMENT,
     BASES,
     BIDS,
     CLAIMS,
@@ -37,6 +38,7 @@ from adapters.assignment.topics import (
     REPORTS,
     SERVICE_REQUESTS,
     TASKS,
+    ack_topic,
     order_topic,
     reply_topic,
 )
@@ -56,6 +58,7 @@ from cosim.messages import (
     ServiceReply,
     ServiceRequest,
     SimplexBasis,
+    TaskAssignment,
     TaskClaim,
     TaskDone,
     TaskInfo,
@@ -90,6 +93,7 @@ class RobotTasks:
     last_sent_ns: int = -(1 << 62)
     epoch: int = 0
     tasks: tuple[TaskInfo, ...] = ()
+    costs: tuple[float, ...] = ()
     protocol: AssignmentProtocol | None = None
     acted: bool = False
     inbox: list[Message] = field(default_factory=list)
@@ -127,6 +131,23 @@ class DtaAdapter:
         self.records = DtaRecords(
             run.recorder, self.names, compare=self.cfg.protocol in ("distributed_simplex", "cbba")
         )
+        self._advertise(run)
+
+    def _advertise(self, run: RunContext) -> None:
+        bus = run.bus
+        for name in self.names:
+            bus.advertise(topic(name, "nav/goal"), NavGoal)
+        bus.advertise(CLAIMS, TaskClaim)
+        bus.advertise(SERVICE_REQUESTS, ServiceRequest)
+        bus.advertise(DONE, TaskDone)
+        protocol = self.cfg.protocol
+        if protocol == "distributed_simplex":
+            bus.advertise(BASES, SimplexBasis)
+        elif protocol == "cbba":
+            bus.advertise(BIDS, AuctionBids)
+        elif protocol == "hungarian":
+            bus.advertise(REPORTS, RobotState)
+        bus.advertise(ASSIGNMENT, TaskAssignment)
 
     # -- wiring ---------------------------------------------------------------------------
     def start(self, run: RunContext) -> None:
@@ -139,6 +160,7 @@ class DtaAdapter:
             bus.subscribe(BASES, host, on)
             bus.subscribe(BIDS, host, on)
             bus.subscribe(reply_topic(robot.name), host, on)
+            bus.subscribe(ack_topic(robot.name), host, on)
             bus.subscribe(order_topic(robot.name), host, on)
             bus.subscribe(topic(robot.name, "nav/status"), host, on)
             bus.subscribe(topic(robot.name, "odom"), host, on)
@@ -194,6 +216,7 @@ class DtaAdapter:
         now = run.kernel.now_ns
         robot.blocked = {t: until for t, until in robot.blocked.items() if until > now}
         problem = self._problem(robot, tasks.tasks)
+        robot.costs = tuple(problem.cost[robot.index].tolist())
         protocol = self.cfg.protocol
         if protocol == "distributed_simplex":
             robot.protocol = SimplexProtocol(
@@ -272,7 +295,23 @@ class DtaAdapter:
         if protocol.decided and (not robot.acted or changed):
             robot.acted = True
             self.records.decided(robot.index, robot.epoch, now_ns, protocol)
+            self._announce(run, robot, now_ns, protocol.task(), protocol.rounds)
             self._act(run, robot, protocol.task())
+
+    def _announce(
+        self, run: RunContext, robot: RobotTasks, now_ns: int, index: int | None, rounds: int
+    ) -> None:
+        """Publish the robot's decision on ``/fleet/assignment`` (for tools and bags)."""
+        known = index is not None and index < len(robot.tasks)
+        decision = TaskAssignment(
+            now_ns,
+            robot.epoch,
+            robot.name,
+            robot.tasks[index].task_id if known and index is not None else -1,
+            robot.costs[index] if known and index is not None else math.nan,
+            rounds,
+        )
+        run.bus.publish(ASSIGNMENT, decision, self.hosts[robot.index])
 
     # -- acting on a decision ------------------------------------------------------------------
     def _act(self, run: RunContext, robot: RobotTasks, index: int | None) -> None:
@@ -386,6 +425,10 @@ class DtaAdapter:
         match = [t for t in robot.tasks if t.task_id == order.task_id]
         if order.robot == robot.name and robot.phase == "idle" and match:
             self._take(run, robot, match[0], order.cost_m)
+            decision = TaskAssignment(
+                run.kernel.now_ns, order.epoch, robot.name, order.task_id, order.cost_m, 0
+            )
+            run.bus.publish(ASSIGNMENT, decision, self.hosts[robot.index])
 
     def _report(self, run: RunContext, now_ns: int) -> None:
         """Centralized baseline: every robot reports its pose to the base station."""

@@ -18,11 +18,18 @@ BASES = "/fleet/dta/bases"
 """SimplexBasis broadcasts among robots (distributed simplex)."""
 BIDS = "/fleet/dta/bids"
 """AuctionBids broadcasts among robots (CBBA)."""
+ASSIGNMENT = "/fleet/assignment"
+"""TaskAssignment: what each robot's protocol decided (for tools; nothing subscribes)."""
 
 
 def reply_topic(robot: str) -> str:
     """ServiceReply to ``robot``."""
     return topic(robot, "service/reply")
+
+
+def ack_topic(robot: str) -> str:
+    """TaskDone acknowledgements of the task source to ``robot``."""
+    return topic(robot, "service/done_ack")
 
 
 def order_topic(robot: str) -> str:

@@ -42,6 +42,8 @@ class WanderAdapter:
         self.ranges = np.full((len(self.names), max(lidar.beams, 1)), np.nan)
         self.angles: np.ndarray | None = None
         self.seen = np.zeros(len(self.names), dtype=bool)
+        for name in self.names:
+            run.bus.advertise(topic(name, "cmd_vel"), Twist)
 
     def start(self, run: RunContext) -> None:
         """Subscribe to every robot's scan and start the control tick."""

@@ -69,6 +69,9 @@ class WaypointsAdapter:
         self._obstacles = prep(obstacles)
         self.reached = 0
         self.abandoned = 0
+        for name in self.names:
+            run.bus.advertise(topic(name, "cmd_vel"), Twist)
+            run.bus.advertise(topic(name, "goal"), Goal)
 
     def start(self, run: RunContext) -> None:
         """Subscribe to odometry, issue first waypoints, start the control tick."""

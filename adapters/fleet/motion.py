@@ -5,7 +5,8 @@ robot's host and, at ``robots.control_hz`` in the PHYSICS stage, advances all ro
 one vectorized step and publishes ``/<robot>/odom``. Before a step is committed, motion
 guards (the collision adapter) may hold robots back. The ``odom`` frame starts aligned
 with ``map`` (each robot is told its start pose, as an initial pose is given to a
-localizer); with ``odometry.drift`` > 0 it drifts away from ground truth.
+localizer); with ``odometry.drift`` > 0 it drifts away from ground truth. Odometry is
+``robot_i/odom`` -> ``robot_i/base_link`` (REP 105 frames with the robot's prefix).
 """
 
 from __future__ import annotations
@@ -62,8 +63,11 @@ class FleetAdapter:
         self.drift = run.scenario.odometry.drift
         self.odom = world.starts.astype(float).copy()
         self._noise = BlockDraws([run.rng.stream(f"odometry/{n}") for n in names], width=2)
+        self._frames = [(f"{n}/odom", f"{n}/base_link") for n in names]
         run.provide(self.state)
         run.provide(self)
+        for name in names:
+            run.bus.advertise(topic(name, "odom"), Odometry)
 
     def add_guard(self, guard: MotionGuard) -> None:
         """Let ``guard`` inspect (and hold back) every proposed step before it is committed."""
@@ -111,10 +115,9 @@ class FleetAdapter:
         publish = run.bus.publish
         for i, host in enumerate(self.hosts):
             x, y, yaw = odom[i]
+            frame, child = self._frames[i]
             publish(
-                self._odom_topics[i],
-                Odometry(now_ns, "odom", "base_link", x, y, yaw, v[i], w[i]),
-                host,
+                self._odom_topics[i], Odometry(now_ns, frame, child, x, y, yaw, v[i], w[i]), host
             )
 
     def finish(self, run: RunContext) -> Mapping[str, Any]:

@@ -49,6 +49,8 @@ class GoalsAdapter:
         self.rngs = [run.rng.stream(f"goals/{n}") for n in self.names]
         self.next_id = np.zeros(len(self.names), dtype=np.int64)
         self.sent = 0
+        for name in self.names:
+            run.bus.advertise(topic(name, "nav/goal"), NavGoal)
 
     def start(self, run: RunContext) -> None:
         """Listen to every robot's navigation status and send the first goals."""

@@ -35,7 +35,16 @@ from cosim.bus import Envelope
 from cosim.errors import ConfigError
 from cosim.hosts import HostId
 from cosim.kernel import Stage
-from cosim.messages import LaserScan, Message, NavGoal, NavStatus, Odometry, RobotState, Twist
+from cosim.messages import (
+    LaserScan,
+    Message,
+    NavGoal,
+    NavStatus,
+    Odometry,
+    Path,
+    RobotState,
+    Twist,
+)
 from cosim.timebase import NS_PER_S, period_ns, s_to_ns
 from models.kinematics import FleetState
 from models.lidar import ScanGeometry
@@ -125,13 +134,23 @@ class NavigationAdapter:
         self.rngs = [run.rng.stream(f"navigation/{name}") for name in self.names]
         self.traffic = TrafficParams()
         self.recovery = Recovery(n, self.memory, self.limits, radius, self.rngs)
+        self.status_topics = [topic(n, "nav/status") for n in self.names]
+        self.cmd_topics = [topic(n, "cmd_vel") for n in self.names]
+        self.plan_topics = [topic(n, "plan") for n in self.names]
+        bus = run.bus
+        for status, cmd, path in zip(
+            self.status_topics, self.cmd_topics, self.plan_topics, strict=True
+        ):
+            bus.advertise(status, NavStatus)
+            bus.advertise(cmd, Twist)
+            bus.advertise(path, Path)
+        if cfg.robots_layer:
+            bus.advertise(ROBOT_STATES, RobotState)
 
     # -- the bus ----------------------------------------------------------------------
     def start(self, run: RunContext) -> None:
         """Subscribe to goals, odometry and scans; start control, status and robots layer."""
         bus = run.bus
-        self.status_topics = [topic(n, "nav/status") for n in self.names]
-        self.cmd_topics = [topic(n, "cmd_vel") for n in self.names]
         for i, (name, host) in enumerate(zip(self.names, self.hosts, strict=True)):
             bus.subscribe(topic(name, "nav/goal"), host, self._on_goal(run, i))
             bus.subscribe(topic(name, "odom"), host, self._on_odom(i))
@@ -278,6 +297,11 @@ class NavigationAdapter:
             waypoints = path_to_world(self.static, cells)
             waypoints[-1] = self.goal[i]
             self.paths.set(i, waypoints)
+            # Nav2's planner publishes every plan it makes on `plan` (for tools; nothing here
+            # subscribes)
+            run.bus.publish(
+                self.plan_topics[i], Path(now_ns, "map", waypoints.copy()), self.hosts[i]
+            )
             # moving things the new path bends around: replan while they may leave
             shaped = paths_blocked(
                 self.paths,

@@ -1,8 +1,13 @@
-"""The pose sampler: writes every robot's ground-truth pose into ``tables/poses``."""
+"""The pose sampler: writes every robot's ground-truth pose into ``tables/poses``.
+
+Other recorders that sample the ground truth at the same rate (the ROS interface's
+``/tf`` and ``/robot_i/ground_truth``) join its tick with :meth:`PosesAdapter.on_sample`
+instead of scheduling their own, so recording more adds no kernel event.
+"""
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any, ClassVar
 
 from cosim.adapter import RunContext
@@ -23,6 +28,12 @@ class PosesAdapter:
         self.fleet = run.service(FleetState)
         self.table = run.recorder.table("poses", POSE_COLUMNS, categorical=("robot",))
         self.period_ns = period_ns(run.scenario.record.pose_rate_hz)
+        self._listeners: list[Callable[[int], None]] = []
+        run.provide(self)
+
+    def on_sample(self, listener: Callable[[int], None]) -> None:
+        """Call ``listener(now_ns)`` after every sample (RECORD stage)."""
+        self._listeners.append(listener)
 
     def start(self, run: RunContext) -> None:
         """Start sampling at time 0."""
@@ -39,6 +50,8 @@ class PosesAdapter:
             v_mps=fleet.v.copy(),
             w_radps=fleet.w.copy(),
         )
+        for listener in self._listeners:
+            listener(now_ns)
 
     def finish(self, run: RunContext) -> Mapping[str, Any]:
         """Nothing to add to the summary."""

@@ -16,6 +16,7 @@ import numpy as np
 
 from adapters.naming import topic
 from cosim.adapter import RunContext
+from cosim.bus import TopicQos
 from cosim.hosts import HostId
 from cosim.kernel import Stage
 from cosim.messages import LaserScan
@@ -68,6 +69,9 @@ class LidarAdapter:
         self._ones = np.ones((len(names), beams), dtype=np.float32)
         self.topics = [topic(name, "scan") for name in self.fleet.names]
         self.scans = 0
+        if cfg.beams > 0:
+            for name in self.topics:
+                run.bus.advertise(name, LaserScan, TopicQos.SENSOR)
 
     def start(self, run: RunContext) -> None:
         """Start the scan tick (disabled when ``lidar.beams`` is 0)."""

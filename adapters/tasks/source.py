@@ -24,6 +24,7 @@ from adapters.assignment.topics import (
     REPORTS,
     SERVICE_REQUESTS,
     TASKS,
+    ack_topic,
     order_topic,
     reply_topic,
 )
@@ -95,6 +96,12 @@ class TaskSourceAdapter:
         self.poses: dict[str, tuple[float, float]] = {}
         self.orders: dict[str, tuple[int, float]] = {}
         run.provide(self)
+        run.bus.advertise(TASKS, TaskSet)
+        for robot in self.robots:
+            run.bus.advertise(reply_topic(robot), ServiceReply)
+            run.bus.advertise(ack_topic(robot), TaskDone)
+            if self.assignment.protocol == "hungarian":
+                run.bus.advertise(order_topic(robot), TaskOrder)
 
     # -- life of tasks ---------------------------------------------------------------
     def start(self, run: RunContext) -> None:
@@ -207,7 +214,7 @@ class TaskSourceAdapter:
     def _on_done(self, run: RunContext, done: TaskDone) -> None:
         now = run.kernel.now_ns
         # acknowledge every report (the robot repeats it until acknowledged)
-        run.bus.publish(reply_topic(done.robot), TaskDone(now, done.task_id, done.robot), BASE_HOST)
+        run.bus.publish(ack_topic(done.robot), TaskDone(now, done.task_id, done.robot), BASE_HOST)
         if self.book.done(done.task_id, done.robot, now):
             run.recorder.event(now, "task_source", "done", f"task {done.task_id} by {done.robot}")
             self.dirty = True

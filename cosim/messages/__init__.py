@@ -10,38 +10,48 @@ Frames follow REP 105: ``map`` (fixed world frame), ``odom`` (drifting, continuo
 ``base_link`` (robot body), ``laser`` (sensor).
 """
 
+from cosim.messages.assignment import AuctionBids, SimplexBasis, TaskAssignment, TaskOrder
 from cosim.messages.base import Message
+from cosim.messages.frames import Clock, TFMessage, Transform
 from cosim.messages.navigation import NavGoal, NavStatus, RobotState
-from cosim.messages.ros import Goal, LaserScan, Odometry, PoseStamped, Twist
+from cosim.messages.ros import Goal, LaserScan, Odometry, Path, PoseStamped, Twist
+from cosim.messages.scene import Marker, MarkerAction, MarkerArray, MarkerType, OccupancyGrid
 from cosim.messages.tasks import (
-    AuctionBids,
     ServiceReply,
     ServiceRequest,
-    SimplexBasis,
     TaskClaim,
     TaskDone,
     TaskInfo,
-    TaskOrder,
     TaskSet,
 )
 
 __all__ = [
     "AuctionBids",
+    "Clock",
     "Goal",
     "LaserScan",
+    "Marker",
+    "MarkerAction",
+    "MarkerArray",
+    "MarkerType",
     "Message",
     "NavGoal",
     "NavStatus",
+    "OccupancyGrid",
     "Odometry",
+    "Path",
     "PoseStamped",
     "RobotState",
     "ServiceReply",
     "ServiceRequest",
     "SimplexBasis",
+    "TFMessage",
+    "TaskAssignment",
     "TaskClaim",
     "TaskDone",
     "TaskInfo",
     "TaskOrder",
     "TaskSet",
+    "Transform",
     "Twist",
 ]

@@ -95,5 +95,13 @@ string robot
 int32 task_id
 float64 cost
 """,
+    "cosim_msgs/msg/TaskAssignment": """
+std_msgs/Header header
+uint32 epoch
+string robot
+int32 task_id
+float64 cost
+uint32 rounds
+""",
 }
 """``.msg`` text by ROS 2 type name."""

@@ -7,6 +7,7 @@ from typing import ClassVar
 
 from cosim.messages.base import Message
 from cosim.messages.cdr import ENCAPSULATION, doubles, header, string, uint32
+from cosim.messages.encoder import CdrWriter
 
 
 @dataclass(frozen=True, slots=True)
@@ -30,6 +31,14 @@ class NavGoal(Message):
     def size_bytes(self) -> int:
         """Header in ``map``, uint32 id, three float64."""
         return ENCAPSULATION + doubles(uint32(header(0, "map")), 3)
+
+    def to_cdr(self) -> bytes:
+        """Header in ``map``, goal id, x, y, yaw."""
+        w = CdrWriter()
+        w.header(self.stamp_ns, "map")
+        w.u32(self.goal_id)
+        w.f64s((self.x_m, self.y_m, self.yaw_rad))
+        return w.data()
 
 
 @dataclass(frozen=True, slots=True)
@@ -58,6 +67,15 @@ class NavStatus(Message):
         offset = string(uint32(header(0, "map")), self.state)
         return ENCAPSULATION + doubles(offset, 3)
 
+    def to_cdr(self) -> bytes:
+        """Header in ``map``, goal id, state, x, y, remaining."""
+        w = CdrWriter()
+        w.header(self.stamp_ns, "map")
+        w.u32(self.goal_id)
+        w.string(self.state)
+        w.f64s((self.x_m, self.y_m, self.remaining_m))
+        return w.data()
+
 
 @dataclass(frozen=True, slots=True)
 class RobotState(Message):
@@ -85,3 +103,11 @@ class RobotState(Message):
     def size_bytes(self) -> int:
         """Header, robot name, five float64."""
         return ENCAPSULATION + doubles(string(header(0, "map"), self.robot), 5)
+
+    def to_cdr(self) -> bytes:
+        """Header in ``map``, robot name, x, y, yaw, v, radius."""
+        w = CdrWriter()
+        w.header(self.stamp_ns, "map")
+        w.string(self.robot)
+        w.f64s((self.x_m, self.y_m, self.yaw_rad, self.v_mps, self.radius_m))
+        return w.data()

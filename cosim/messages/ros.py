@@ -6,6 +6,8 @@ Frames follow REP 105: ``map`` (fixed world frame), ``odom`` (drifting, continuo
 
 from __future__ import annotations
 
+import math
+import struct
 from dataclasses import dataclass, field
 from typing import ClassVar
 
@@ -19,7 +21,16 @@ from cosim.messages.cdr import (
     header,
     odometry_size,
     scan_size,
+    uint32,
 )
+from cosim.messages.encoder import HEADER, CdrWriter, strings_block, time_bytes
+
+_ODOM_BODY = struct.Struct("<2d24x2d288xd32xd288x")
+"""Odometry after its strings: x, y, (z, qx, qy = 0), qz, qw, zero covariance, v, 0 x 4, w,
+zero covariance."""
+_SCAN_FIELDS = struct.Struct("<7fI")
+"""LaserScan after its header: 7 float32 fields and the count of ranges."""
+_NO_INTENSITIES = bytes(4)
 
 
 @dataclass(frozen=True, slots=True)
@@ -38,6 +49,12 @@ class Twist(Message):
     def size_bytes(self) -> int:
         """Two Vector3 of float64."""
         return ENCAPSULATION + 48
+
+    def to_cdr(self) -> bytes:
+        """Linear (x, 0, 0) and angular (0, 0, z) Vector3."""
+        w = CdrWriter()
+        w.f64s((self.linear_x_mps, 0.0, 0.0, 0.0, 0.0, self.angular_z_radps))
+        return w.data()
 
 
 @dataclass(frozen=True, slots=True)
@@ -66,6 +83,20 @@ class Odometry(Message):
         """Header, child frame, PoseWithCovariance (7+36 doubles), TwistWithCovariance (6+36)."""
         return odometry_size(self.frame_id, self.child_frame_id)
 
+    def to_cdr(self) -> bytes:
+        """Planar pose and twist; both covariances zero (unknown, as many drivers send)."""
+        half = 0.5 * self.yaw_rad
+        return b"".join(
+            (
+                HEADER,
+                time_bytes(self.stamp_ns),
+                strings_block(8, (self.frame_id, self.child_frame_id), 8),
+                _ODOM_BODY.pack(
+                    self.x_m, self.y_m, math.sin(half), math.cos(half), self.v_mps, self.w_radps
+                ),
+            )
+        )
+
 
 @dataclass(frozen=True, slots=True)
 class PoseStamped(Message):
@@ -87,6 +118,13 @@ class PoseStamped(Message):
     def size_bytes(self) -> int:
         """Header plus Point and Quaternion (7 doubles)."""
         return ENCAPSULATION + doubles(header(0, self.frame_id), 7)
+
+    def to_cdr(self) -> bytes:
+        """Header and planar pose."""
+        w = CdrWriter()
+        w.header(self.stamp_ns, self.frame_id)
+        w.pose2d(self.x_m, self.y_m, self.yaw_rad)
+        return w.data()
 
 
 @dataclass(frozen=True, slots=True)
@@ -127,6 +165,30 @@ class LaserScan(Message):
         """Header, 7 float32 fields, ranges and an empty intensities sequence."""
         return scan_size(self.frame_id, len(self.ranges_m))
 
+    def to_cdr(self) -> bytes:
+        """Header, angles, times, range limits, ranges; no intensities."""
+        ranges = self.ranges_m
+        fields = _SCAN_FIELDS.pack(
+            self.angle_min_rad,
+            self.angle_max_rad,
+            self.angle_increment_rad,
+            0.0,  # time_increment: every beam of a sweep is cast at its stamp
+            self.scan_time_s,
+            self.range_min_m,
+            self.range_max_m,
+            len(ranges),
+        )
+        return b"".join(
+            (
+                HEADER,
+                time_bytes(self.stamp_ns),
+                strings_block(8, (self.frame_id,), 4),
+                fields,
+                np.ascontiguousarray(ranges, dtype="<f4").tobytes(),
+                _NO_INTENSITIES,
+            )
+        )
+
 
 @dataclass(frozen=True, slots=True)
 class Goal(Message):
@@ -147,3 +209,50 @@ class Goal(Message):
     def size_bytes(self) -> int:
         """Same layout as a PoseStamped in ``map``."""
         return ENCAPSULATION + doubles(header(0, "map"), 7)
+
+    def to_cdr(self) -> bytes:
+        """A PoseStamped in ``map``; no heading is written as yaw 0."""
+        yaw = self.yaw_rad if math.isfinite(self.yaw_rad) else 0.0
+        return PoseStamped(self.stamp_ns, "map", self.x_m, self.y_m, yaw).to_cdr()
+
+
+@dataclass(frozen=True, slots=True)
+class Path(Message):
+    """A planned path (``nav_msgs/msg/Path``), as Nav2's planner publishes on ``plan``.
+
+    Attributes:
+        stamp_ns: when the path was planned, ns.
+        frame_id: frame of the waypoints (``map``).
+        xy_m: waypoints (k, 2) in ``frame_id`` (m), read-only; each pose's heading points
+            along the path to the next waypoint.
+    """
+
+    ros_type: ClassVar[str] = "nav_msgs/msg/Path"
+    stamp_ns: int
+    frame_id: str
+    xy_m: npt.NDArray[np.float64] = field(repr=False)
+
+    def __post_init__(self) -> None:
+        self.xy_m.flags.writeable = False
+
+    def size_bytes(self) -> int:
+        """Header and a sequence of PoseStamped in the same frame."""
+        offset = uint32(header(0, self.frame_id))
+        for _ in range(len(self.xy_m)):
+            offset = doubles(header(offset, self.frame_id), 7)
+        return ENCAPSULATION + offset
+
+    def to_cdr(self) -> bytes:
+        """Header, then every waypoint as a PoseStamped with the path's stamp and frame."""
+        w = CdrWriter()
+        w.header(self.stamp_ns, self.frame_id)
+        xy = self.xy_m
+        w.u32(len(xy))
+        if len(xy):
+            step = np.diff(xy, axis=0)
+            yaw = np.arctan2(step[:, 1], step[:, 0]).tolist()
+            yaw.append(yaw[-1] if yaw else 0.0)
+            for (x, y), heading in zip(xy.tolist(), yaw, strict=True):
+                w.header(self.stamp_ns, self.frame_id)
+                w.pose2d(x, y, heading)
+        return w.data()

@@ -1,4 +1,4 @@
-"""Fleet coordination messages (``cosim_msgs``): tasks, claims, service, protocol rounds.
+"""Fleet coordination messages (``cosim_msgs``): tasks, claims and service.
 
 Task ids are non-negative integers given by the task source; robots are named. Sizes are
 those of the CDR encoding of the documented field layout.
@@ -7,11 +7,11 @@ those of the CDR encoding of the documented field layout.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
 from typing import ClassVar
 
 from cosim.messages.base import Message
 from cosim.messages.cdr import ENCAPSULATION, doubles, header, string, uint32
+from cosim.messages.encoder import CdrWriter
 
 
 @dataclass(frozen=True, slots=True)
@@ -39,6 +39,13 @@ class TaskInfo:
             offset = string(offset, name)
         return string(offset, self.holder)
 
+    def write(self, w: CdrWriter) -> None:
+        """Append this element to a message being encoded."""
+        w.u32(self.task_id)
+        w.f64s((self.x_m, self.y_m))
+        w.strings(self.eligible)
+        w.string(self.holder)
+
 
 @dataclass(frozen=True, slots=True)
 class TaskSet(Message):
@@ -61,6 +68,16 @@ class TaskSet(Message):
         for task in self.tasks:
             offset = task.end(offset)
         return ENCAPSULATION + offset
+
+    def to_cdr(self) -> bytes:
+        """Header in ``map``, epoch, the tasks."""
+        w = CdrWriter()
+        w.header(self.stamp_ns, "map")
+        w.u32(self.epoch)
+        w.u32(len(self.tasks))
+        for task in self.tasks:
+            task.write(w)
+        return w.data()
 
 
 @dataclass(frozen=True, slots=True)
@@ -89,6 +106,17 @@ class TaskClaim(Message):
         offset = string(uint32(uint32(header(0, "map"))), self.robot)
         return ENCAPSULATION + string(doubles(offset, 1), self.state)
 
+    def to_cdr(self) -> bytes:
+        """Header in ``map``, epoch, task id, robot, cost, state."""
+        w = CdrWriter()
+        w.header(self.stamp_ns, "map")
+        w.u32(self.epoch)
+        w.u32(self.task_id)
+        w.string(self.robot)
+        w.f64(self.cost_m)
+        w.string(self.state)
+        return w.data()
+
 
 @dataclass(frozen=True, slots=True)
 class ServiceRequest(Message):
@@ -110,6 +138,10 @@ class ServiceRequest(Message):
     def size_bytes(self) -> int:
         """Header, uint32, robot name."""
         return ENCAPSULATION + string(uint32(header(0, "map")), self.robot)
+
+    def to_cdr(self) -> bytes:
+        """Header in ``map``, task id, robot."""
+        return _task_robot(self.stamp_ns, self.task_id, self.robot).data()
 
 
 @dataclass(frozen=True, slots=True)
@@ -133,6 +165,12 @@ class ServiceReply(Message):
         """Header, uint32, robot name, bool."""
         return ENCAPSULATION + string(uint32(header(0, "map")), self.robot) + 1
 
+    def to_cdr(self) -> bytes:
+        """Header in ``map``, task id, robot, granted."""
+        w = _task_robot(self.stamp_ns, self.task_id, self.robot)
+        w.boolean(self.granted)
+        return w.data()
+
 
 @dataclass(frozen=True, slots=True)
 class TaskDone(Message):
@@ -153,105 +191,25 @@ class TaskDone(Message):
         """Header, uint32, robot name."""
         return ENCAPSULATION + string(uint32(header(0, "map")), self.robot)
 
-
-Column = tuple[int, int, int, float]
-"""A column of the assignment LP: (kind, robot index, task index, cost)."""
-
-
-@lru_cache(maxsize=1024)
-def _columns_end(offset: int, count: int) -> int:
-    # per column: uint8 kind, int32 robot, int32 task, float64 cost
-    offset = uint32(offset)
-    for _ in range(count):
-        offset = doubles(uint32(uint32(offset + 1)), 1)
-    return offset
+    def to_cdr(self) -> bytes:
+        """Header in ``map``, task id, robot."""
+        return _task_robot(self.stamp_ns, self.task_id, self.robot).data()
 
 
-@dataclass(frozen=True, slots=True)
-class SimplexBasis(Message):
-    """A robot's current basis in a distributed-simplex round (``cosim_msgs/msg/SimplexBasis``).
-
-    Attributes:
-        stamp_ns: send time, ns.
-        epoch: the assignment problem it belongs to.
-        robot: the sender.
-        round: the sender's round number in the epoch.
-        columns: the basis columns (kind, robot index, task index, cost).
-    """
-
-    ros_type: ClassVar[str] = "cosim_msgs/msg/SimplexBasis"
-    stamp_ns: int
-    epoch: int
-    robot: str
-    round: int
-    columns: tuple[Column, ...]
-
-    def size_bytes(self) -> int:
-        """Header, uint32 epoch, robot name, uint32 round, sequence of columns."""
-        offset = uint32(string(uint32(header(0, "map")), self.robot))
-        return ENCAPSULATION + _columns_end(offset, len(self.columns))
-
-
-@dataclass(frozen=True, slots=True)
-class AuctionBids(Message):
-    """A robot's view of the winning bids (CBBA consensus; ``cosim_msgs/msg/AuctionBids``).
-
-    Attributes:
-        stamp_ns: send time, ns.
-        epoch: the assignment problem it belongs to.
-        robot: the sender.
-        bids: winning bid known per task index.
-        winners: winning robot index known per task index (-1: none).
-    """
-
-    ros_type: ClassVar[str] = "cosim_msgs/msg/AuctionBids"
-    stamp_ns: int
-    epoch: int
-    robot: str
-    bids: tuple[float, ...]
-    winners: tuple[int, ...]
-
-    def size_bytes(self) -> int:
-        """Header, uint32 epoch, robot name, float64 sequence, int32 sequence."""
-        offset = string(uint32(header(0, "map")), self.robot)
-        offset = doubles(uint32(offset), len(self.bids))
-        return ENCAPSULATION + uint32(offset) + 4 * len(self.winners)
-
-
-@dataclass(frozen=True, slots=True)
-class TaskOrder(Message):
-    """The base station tells a robot its task (centralized baseline; ``cosim_msgs/msg/TaskOrder``).
-
-    Attributes:
-        stamp_ns: send time, ns.
-        epoch: the epoch the order was computed in.
-        robot: the robot.
-        task_id: its task, or -1 for none.
-        cost_m: the robot's cost for it (m).
-    """
-
-    ros_type: ClassVar[str] = "cosim_msgs/msg/TaskOrder"
-    stamp_ns: int
-    epoch: int
-    robot: str
-    task_id: int
-    cost_m: float
-
-    def size_bytes(self) -> int:
-        """Header, uint32 epoch, robot name, int32, float64."""
-        offset = uint32(string(uint32(header(0, "map")), self.robot))
-        return ENCAPSULATION + doubles(offset, 1)
+def _task_robot(stamp_ns: int, task_id: int, robot: str) -> CdrWriter:
+    """A writer holding the header, task id and robot shared by the service messages."""
+    w = CdrWriter()
+    w.header(stamp_ns, "map")
+    w.u32(task_id)
+    w.string(robot)
+    return w
 
 
 __all__ = [
-    "AuctionBids",
-    "Column",
     "ServiceReply",
     "ServiceRequest",
-    "SimplexBasis",
     "TaskClaim",
     "TaskDone",
     "TaskInfo",
-    "TaskOrder",
     "TaskSet",
 ]
