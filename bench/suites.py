@@ -13,6 +13,7 @@ from dwa_bench import dwa_us_per_robot
 from lidar_bench import lidar_rays_per_second
 from network_bench import network_deliveries_per_second
 from planner_bench import planner_ms
+from recording_bench import bag_cost, bag_memory_1h, encoding
 
 import cosim
 from cosim.adapter import RunContext
@@ -332,4 +333,7 @@ SUITES: dict[str, Callable[[int], Result]] = {
     "fleet50_physics": fleet50_physics,
     "fleet50_wander": fleet50_wander,
     "fleet1000_wander": fleet1000_wander,
+    "bag_cost": bag_cost,
+    "bag_memory_1h": bag_memory_1h,
+    "cdr_encoding": encoding,
 }

@@ -7,11 +7,12 @@ value and what was expected); 1 internal failure (a bug: the traceback is printe
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import traceback
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import TYPE_CHECKING, Any, NoReturn
 
 from cosim.errors import ConfigError, CosimError
 from cosim.progress import ProgressLine
@@ -32,6 +33,10 @@ HIGHLIGHTS = (
     ("latency_ms_p50", "ms median latency"),
 )
 """Summary metrics shown after a run, when the run has them."""
+
+if TYPE_CHECKING:
+    from cosim.recording.session import RecordingSession
+    from cosim.runner import RunResult
 
 EXIT_OK = 0
 EXIT_BUG = 1
@@ -72,6 +77,29 @@ def _positive_float(text: str) -> float:
     return value
 
 
+def _port(text: str) -> int:
+    value = _non_negative_int(text)
+    if value > 65535:
+        raise argparse.ArgumentTypeError(f"{value} is not a TCP port (expected 0 to 65535)")
+    return value
+
+
+def _times(text: str) -> list[float]:
+    values = []
+    for part in text.split(","):
+        try:
+            value = float(part)
+        except ValueError:
+            raise argparse.ArgumentTypeError(
+                f"{part.strip()!r} in {text!r} is not a number; expected times in s, "
+                "comma-separated (e.g. 10,20,30)"
+            ) from None
+        if not value >= 0 or value == float("inf"):
+            raise argparse.ArgumentTypeError(f"{part.strip()} is not a finite time >= 0 (s)")
+        values.append(value)
+    return values
+
+
 def _scenario_argument(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "scenario",
@@ -106,7 +134,8 @@ def build_parser() -> argparse.ArgumentParser:
         help="run a scenario and write its results folder",
         description=(
             "Run a scenario to its duration and write summary.json, scenario.toml (the fully "
-            "resolved scenario) and tables/*.parquet into the output folder."
+            "resolved scenario), tables/*.parquet and a ROS 2 bag (bag/, written while the "
+            "run goes) into the output folder."
         ),
     )
     _scenario_argument(run)
@@ -115,6 +144,43 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--duration-s", type=_positive_float, help="override scenario.duration_s (s)")
     run.add_argument("--force", action="store_true", help="replace results in a non-empty --out")
     run.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    run.add_argument(
+        "--bag",
+        choices=("mcap", "sqlite3", "none"),
+        help="ROS 2 bag in OUT/bag: mcap (default; Foxglove, ros2 bag), sqlite3 (.db3) or "
+        "none (same as --set record.bag=...; topics from record.topics)",
+    )
+    run.add_argument(
+        "--figures", action="store_true", help="draw the run's figures into OUT/figures at the end"
+    )
+    run.add_argument(
+        "--gif", action="store_true", help="also write an animation OUT/figures/run.gif"
+    )
+    live = run.add_argument_group(
+        "live view",
+        "Serve the run over the Foxglove WebSocket protocol while it goes, paced against the "
+        "wall clock: in Foxglove, Open connection > Foxglove WebSocket > ws://HOST:PORT.",
+    )
+    live.add_argument("--live", action="store_true", help="serve the run live to Foxglove")
+    live.add_argument(
+        "--live-port", type=_port, default=8765, help="TCP port of the live view (default 8765)"
+    )
+    live.add_argument(
+        "--live-host",
+        default="127.0.0.1",
+        help="address to bind (default 127.0.0.1: this machine only; 0.0.0.0: every interface)",
+    )
+    live.add_argument(
+        "--live-rate",
+        type=_positive_float,
+        default=1.0,
+        help="simulated seconds per wall-clock second (default 1.0: real time)",
+    )
+    live.add_argument(
+        "--live-wait",
+        action="store_true",
+        help="start the run only once a viewer has subscribed to a topic",
+    )
 
     check = commands.add_parser(
         "check",
@@ -172,6 +238,41 @@ def build_parser() -> argparse.ArgumentParser:
         "--quiet", action="store_true", help="no progress bar (the summary lines remain)"
     )
 
+    bag = commands.add_parser(
+        "bag",
+        help="look into ROS 2 bags (ours, or any rosbag2 recording)",
+        description="Commands on ROS 2 bags: a rosbag2 folder, or a bare .mcap or .db3 file.",
+    )
+    bag_commands = bag.add_subparsers(dest="bag_command", metavar="COMMAND", parser_class=_Parser)
+    bag_commands.required = True
+    info = bag_commands.add_parser(
+        "info",
+        help="print a bag's topics, types, message counts and duration",
+        description="Print a bag's storage, size, message count, time span, and per topic its "
+        "type and message count.",
+    )
+    info.add_argument("bag", metavar="BAG", type=Path, help="a bag folder, or a .mcap/.db3 file")
+
+    plot = commands.add_parser(
+        "plot",
+        help="draw a run's figures from its folder",
+        description=(
+            "Draw figures of a run from its folder alone (scenario.toml and tables/), so any "
+            "earlier run can be plotted: the world with trajectories, snapshots with trails, "
+            "a task timeline, the network over time, assignment convergence. PNGs go to "
+            "RUN_DIR/figures/."
+        ),
+    )
+    plot.add_argument("run_dir", metavar="RUN_DIR", type=Path, help="a run's folder")
+    plot.add_argument(
+        "--at",
+        type=_times,
+        metavar="T1,T2,...",
+        help="snapshot times (s), comma-separated (default: evenly spaced over the run)",
+    )
+    plot.add_argument("--gif", action="store_true", help="also write an animation run.gif")
+    plot.add_argument("--out", type=Path, help="folder for the figures (default RUN_DIR/figures)")
+
     commands.add_parser(
         "scenarios",
         help="list the presets, one line each",
@@ -198,41 +299,97 @@ def _describe(scenario: Scenario) -> str:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
+    from cosim.recording.live import LiveOptions
     from cosim.runner import run
 
+    if args.bag is not None:
+        args.overrides.append(f"record.bag={args.bag}")
     scenario = _load(args)
     if args.seed is not None:
         scenario = scenario.with_seed(args.seed)
     out = args.out or Path("runs") / f"{scenario.name}-seed{scenario.seed}"
+    live = (
+        LiveOptions(args.live_host, args.live_port, args.live_rate, args.live_wait)
+        if args.live
+        else None
+    )
     progress = None if args.quiet else ProgressLine(label=f"{scenario.name}: ")
     try:
         result = run(
-            scenario, duration_s=args.duration_s, out=out, force=args.force, progress=progress
+            scenario,
+            duration_s=args.duration_s,
+            out=out,
+            force=args.force,
+            progress=progress,
+            live=live,
+            on_ready=lambda session: _ready(session, quiet=args.quiet),
         )
     finally:
         if progress is not None:
             progress.close()
+    figures = []
+    if args.figures or args.gif:
+        from cosim.plotting.command import plot_run
+
+        figures = plot_run(out, gif=args.gif)
     if not args.quiet:
-        s = result.summary
-        print(
-            f"{s['scenario']} seed {s['seed']}: {s['sim_time_s']:g} s simulated in "
-            f"{s['wall_time_s']:.2f} s ({s['real_time_factor']:g}x real time), "
-            f"{s['robots']} robots, {s['events']} events, {s['messages_sent']} messages"
-        )
-        highlights = [f"{s[key]} {label}" for key, label in HIGHLIGHTS if s.get(key) is not None]
-        if highlights:
-            print("  " + ", ".join(highlights))
-        tables = ", ".join(sorted(result.tables))
-        print(f"results: {out}/  (summary.json, scenario.toml, tables/: {tables})")
+        _print_run(result, out, figures)
     return EXIT_OK
+
+
+def _ready(session: RecordingSession, *, quiet: bool) -> None:
+    """Say where the live view is; hold the run for a viewer when asked to."""
+    live = session.live
+    if live is None:
+        return
+    if not quiet:
+        print(
+            f"live view: {live.url}  (Foxglove: Open connection > Foxglove WebSocket; "
+            f"{live.options.rate:g}x real time)",
+            flush=True,
+        )
+    if live.options.wait:
+        if not quiet:
+            print("waiting for a viewer to subscribe (Ctrl-C to stop) ...", flush=True)
+        while not live.subscribed.wait(timeout=0.5):
+            pass
+
+
+def _print_run(result: RunResult, out: Path, figures: list[Path]) -> None:
+    s = result.summary
+    print(
+        f"{s['scenario']} seed {s['seed']}: {s['sim_time_s']:g} s simulated in "
+        f"{s['wall_time_s']:.2f} s ({s['real_time_factor']:g}x real time), "
+        f"{s['robots']} robots, {s['events']} events, {s['messages_sent']} messages"
+    )
+    highlights = [f"{s[key]} {label}" for key, label in HIGHLIGHTS if s.get(key) is not None]
+    if highlights:
+        print("  " + ", ".join(highlights))
+    tables = ", ".join(sorted(result.tables))
+    print(f"results: {out}/  (summary.json, scenario.toml, tables/: {tables})")
+    if result.bag is not None:
+        recorded = sum(result.recorded.values())
+        size_mb = sum(p.stat().st_size for p in result.bag.iterdir() if p.is_file()) / 1e6
+        print(
+            f"bag: {result.bag}/  ({recorded} messages on {len(result.recorded)} topics, "
+            f"{size_mb:.1f} MB; `cosim bag info {result.bag}`, or open it in Foxglove)"
+        )
+    if figures:
+        print(f"figures: {', '.join(str(f) for f in figures)}")
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
     from cosim.assembly import assemble
+    from cosim.recording.session import RecordingSession
     from cosim.scenario import dump_scenario
 
     scenario = _load(args)
-    assemble(scenario)  # builds the world and every adapter: impossible requests fail here
+    # builds the world and every adapter: impossible requests fail here, as do topic
+    # patterns that match nothing the run would record
+    recording = scenario.record.bag != "none"
+    assembly = assemble(scenario, recording=recording)
+    if recording:
+        RecordingSession.topics_of(scenario, assembly.run.bus)
     print(f"ok: {_describe(scenario)}")
     if args.print:
         print(dump_scenario(scenario), end="")
@@ -288,6 +445,21 @@ def _cmd_study(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _cmd_bag(args: argparse.Namespace) -> int:
+    from cosim.recording.reading import bag_info, format_info
+
+    print(format_info(bag_info(args.bag)))
+    return EXIT_OK
+
+
+def _cmd_plot(args: argparse.Namespace) -> int:
+    from cosim.plotting.command import plot_run
+
+    for path in plot_run(args.run_dir, at=args.at, gif=args.gif, out=args.out):
+        print(f"wrote {path}")
+    return EXIT_OK
+
+
 def _cmd_scenarios(_args: argparse.Namespace) -> int:
     names = preset_names()
     width = max(len(n) for n in names)
@@ -301,6 +473,8 @@ COMMANDS = {
     "check": _cmd_check,
     "world": _cmd_world,
     "study": _cmd_study,
+    "bag": _cmd_bag,
+    "plot": _cmd_plot,
     "scenarios": _cmd_scenarios,
 }
 
@@ -317,6 +491,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("cosim: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:
+        # the reader left (`cosim bag info BAG | head`): stop quietly as Unix tools do, and
+        # keep the interpreter from failing to flush stdout on exit
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_OK
     except Exception:
         traceback.print_exc()
         print(

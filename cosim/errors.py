@@ -28,6 +28,10 @@ class ExportError(CosimError):
     """Results cannot be written (existing output folder, unwritable path, ...)."""
 
 
+class BagError(CosimError):
+    """A file or folder given as a ROS 2 bag is not one, or cannot be read."""
+
+
 class WorkerError(CosimError):
     """A study's worker process died or its Dask cluster went away mid-study."""
 

@@ -75,12 +75,18 @@ class Kernel:
     Args:
         realtime: pace the run against the wall clock (``simpy.rt.RealtimeEnvironment``,
             non-strict; lateness is the caller's to measure and report).
+        speed: simulated seconds per wall-clock second when ``realtime`` (1.0: real time).
     """
 
-    def __init__(self, *, realtime: bool = False) -> None:
+    def __init__(self, *, realtime: bool = False, speed: float = 1.0) -> None:
         self.env: simpy.Environment
+        if not speed > 0:
+            raise ValueError(f"real-time speed must be > 0, got {speed}")
+        self.realtime = realtime
         if realtime:
-            self.env = simpy.rt.RealtimeEnvironment(initial_time=0, factor=1e-9, strict=False)
+            self.env = simpy.rt.RealtimeEnvironment(
+                initial_time=0, factor=1e-9 / speed, strict=False
+            )
         else:
             self.env = simpy.Environment(initial_time=0)
         self.events_processed = 0
@@ -164,6 +170,8 @@ class Kernel:
             progress_interval_s: wall-clock seconds between progress calls.
         """
         env = self.env
+        if isinstance(env, simpy.rt.RealtimeEnvironment) and self.events_processed == 0:
+            env.sync()  # the wall clock starts with the run, not when the kernel was built
         step = env.step
         peek = env.peek
         processed = 0

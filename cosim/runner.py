@@ -14,8 +14,10 @@ from typing import Any
 
 import pandas as pd
 
-from cosim.assembly import assemble
+from cosim.assembly import Assembly, assemble
 from cosim.errors import ExportError
+from cosim.recording.live import LiveOptions
+from cosim.recording.session import RecordingPlan, RecordingSession
 from cosim.records import merge_counts
 from cosim.registry import AdapterRegistry
 from cosim.scenario.loader import dump_scenario
@@ -38,6 +40,8 @@ class RunResult:
         summary: flat metrics and provenance.
         tables: DataFrames by table name (``poses``, ``messages``, ``events``, ...).
         out: the run folder, when written.
+        bag: the bag directory, when one was written.
+        recorded: messages recorded per topic (bag or live view).
     """
 
     scenario: Scenario
@@ -45,6 +49,8 @@ class RunResult:
     tables: dict[str, pd.DataFrame] = field(repr=False)
     out: Path | None = None
     volatile: dict[str, tuple[str, ...]] = field(default_factory=dict, repr=False)
+    bag: Path | None = None
+    recorded: dict[str, int] = field(default_factory=dict, repr=False)
 
     def deterministic_tables(self) -> dict[str, pd.DataFrame]:
         """The tables without their wall-clock columns: equal for equal scenario and seed."""
@@ -65,16 +71,60 @@ def execute(
     progress: ProgressFn | None = None,
     names: list[str] | None = None,
     registry: AdapterRegistry | None = None,
+    out: Path | None = None,
+    force: bool = False,
+    live: LiveOptions | None = None,
+    on_ready: Callable[[RecordingSession], None] | None = None,
 ) -> RunResult:
-    """Run a scenario to its duration in memory and return its result.
+    """Run a scenario to its duration and return its result.
+
+    Everything that can be refused (the scenario's world and adapters, the topics to
+    record, the output folder, the live port) is checked before the run starts.
 
     Args:
         scenario: the scenario.
         progress: called with (sim s, duration s, wall s) during the run.
         names: adapters to run instead of the scenario's (see :func:`cosim.assembly.assemble`).
         registry: adapter registry; defaults to the installed entry points.
+        out: the run folder: the bag streams into ``out/bag`` while the run goes (per
+            ``record.bag``); the other results are written by :func:`write_run`.
+        force: replace the results in a non-empty ``out``.
+        live: serve the run to Foxglove over WebSocket, paced by the real-time kernel.
+        on_ready: called with the recording session once sinks are open, before the run
+            (the command line prints the live view's address there).
     """
-    assembly = assemble(scenario, names=names, registry=registry)
+    plan = RecordingPlan.for_run(scenario, out, live)
+    assembly = assemble(
+        scenario,
+        names=names,
+        registry=registry,
+        realtime=live is not None,
+        speed=live.rate if live is not None else 1.0,
+        recording=plan.active,
+    )
+    run = assembly.run
+    topics = RecordingSession.topics_of(scenario, run.bus) if plan.active else {}
+    session = RecordingSession(plan, topics, run.bus)
+    folder = Path(out) if out is not None else None
+    prepare = None if folder is None else lambda: prepare_out(folder, force=force)
+    if plan.active:
+        session.open(before_bag=prepare)
+    elif prepare is not None:
+        prepare()
+    try:
+        if on_ready is not None:
+            on_ready(session)
+        result = _run_assembled(scenario, assembly, progress)
+    finally:
+        session.close()
+    result.bag = plan.bag
+    result.recorded = session.counts()
+    return result
+
+
+def _run_assembled(
+    scenario: Scenario, assembly: Assembly, progress: ProgressFn | None
+) -> RunResult:
     run = assembly.run
     duration_s = scenario.scenario.duration_s
     until_ns = s_to_ns(duration_s)
@@ -166,6 +216,8 @@ def run(
     out: str | Path | None = None,
     force: bool = False,
     progress: ProgressFn | None = None,
+    live: LiveOptions | None = None,
+    on_ready: Callable[[RecordingSession], None] | None = None,
 ) -> RunResult:
     """Run a scenario; optionally write its folder.
 
@@ -173,9 +225,11 @@ def run(
         scenario: from :func:`cosim.load_scenario`.
         seed: overrides ``scenario.seed``.
         duration_s: overrides ``scenario.duration_s`` (s).
-        out: folder to write (``summary.json``, ``scenario.toml``, ``tables/``).
+        out: folder to write (``summary.json``, ``scenario.toml``, ``tables/``, ``bag/``).
         force: replace the results in a non-empty ``out``.
         progress: called with (sim s, duration s, wall s) during the run.
+        live: serve the run live to Foxglove (see :class:`cosim.recording.live.LiveOptions`).
+        on_ready: called once the recording is set up, before the run starts.
 
     Returns:
         The run's summary and tables.
@@ -184,9 +238,10 @@ def run(
         scenario = scenario.with_seed(seed)
     if duration_s is not None:
         scenario = scenario.with_duration(duration_s)
-    if out is not None:
-        prepare_out(Path(out), force=force)
-    result = execute(scenario, progress=progress)
-    if out is not None:
-        write_run(result, Path(out), tables=scenario.record.tables)
+    folder = Path(out) if out is not None else None
+    result = execute(
+        scenario, progress=progress, out=folder, force=force, live=live, on_ready=on_ready
+    )
+    if folder is not None:
+        write_run(result, folder, tables=scenario.record.tables)
     return result

@@ -136,13 +136,39 @@ class OdometryConfig:
     )
 
 
+DEFAULT_TOPICS = ("*", "!/fleet/dta/*", "!/fleet/robot_states", "!/robot_*/cmd_vel")
+"""Bag topics by default: everything but protocol rounds, robots-layer and velocity chatter."""
+
+
 @dataclass(frozen=True)
 class RecordConfig:
     """``[record]``: what the run keeps."""
 
-    pose_rate_hz: float = param(10.0, "ground-truth pose sampling rate for tables/poses (Hz)", gt=0)
+    pose_rate_hz: float = param(
+        10.0,
+        "ground-truth sampling rate for tables/poses and the bag's /tf, /clock and "
+        "/robot_i/ground_truth (Hz)",
+        gt=0,
+    )
     messages: bool = param(True, "keep one row per message in tables/messages")
     tables: bool = param(True, "write tables/*.parquet")
+    bag: Literal["mcap", "sqlite3", "none"] = param(
+        "mcap", "ROS 2 bag in bag/: MCAP (Foxglove, ros2 bag), sqlite3 (.db3), or none"
+    )
+    topics: tuple[str, ...] = param(
+        DEFAULT_TOPICS,
+        "topics in the bag and the live view: glob patterns ('*' any text), in order; one "
+        "starting with '!' removes what it matches",
+    )
+    compression: Literal["zstd", "none"] = param(
+        "zstd", "bag compression: zstd chunks (MCAP) or zstd messages (sqlite3), or none"
+    )
+
+    def problems(self) -> Iterator[Problem]:
+        """Topic patterns must not be empty."""
+        for pattern in self.topics:
+            if not pattern.lstrip("!"):
+                yield Problem("topics", list(self.topics), "non-empty glob patterns")
 
 
 @dataclass(frozen=True)

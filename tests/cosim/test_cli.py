@@ -157,6 +157,22 @@ def test_invalid_scenario_files_exit_2_with_one_line_naming_the_key(tmp_path, co
             "world.shelf_count = 400",
         ),
         (["frobnicate"], "invalid choice"),
+        (["run", "warehouse-random", "--bag", "rosbag1"], "argument --bag: invalid choice"),
+        (
+            ["run", "warehouse-random", "--set", 'record.topics=["/robot_*/lidar"]'],
+            "pattern '/robot_*/lidar' matches no topic of this run",
+        ),
+        (
+            ["check", "warehouse-random", "--set", 'record.topics=["/nothing"]'],
+            "pattern '/nothing' matches no topic",
+        ),
+        (["run", "warehouse-random", "--live-port", "70000"], "not a TCP port"),
+        (["run", "warehouse-random", "--live-rate", "0"], "not a finite number > 0"),
+        (["bag", "info", "."], "not a ROS 2 bag"),
+        (["bag", "info", "nowhere"], "nowhere: no such file or folder"),
+        (["bag"], "the following arguments are required"),
+        (["plot", "."], "scenario.toml"),
+        (["plot", ".", "--at", "ten"], "'ten' in 'ten' is not a number"),
     ],
 )
 def test_invalid_command_lines_exit_2_with_one_line(tmp_path, args, fragment):
@@ -190,8 +206,25 @@ def test_help_explains_every_command():
     for command in ("run", "check", "scenarios"):
         assert command in done.stdout
     run_help = cosim_cli("run", "--help").stdout
-    for flag in ("--out", "--seed", "--duration-s", "--set", "--quiet", "--force"):
+    for flag in ("--out", "--seed", "--duration-s", "--set", "--quiet", "--force", "--bag"):
         assert flag in run_help
+    for flag in ("--figures", "--gif", "--live", "--live-port", "--live-rate", "--live-host"):
+        assert flag in run_help
+    assert "RUN_DIR" in cosim_cli("plot", "--help").stdout
+    assert "BAG" in cosim_cli("bag", "info", "--help").stdout
+
+
+def test_run_with_figures_writes_them_and_says_where(tmp_path):
+    out = tmp_path / "run"
+    done = cosim_cli(
+        "run", "warehouse-random", "--out", str(out), "--duration-s", "2", "--figures", *SMALL
+    )
+    assert done.returncode == 0, done.stderr
+    assert (out / "figures" / "trajectories.png").is_file()
+    assert "figures: " in done.stdout and f"bag: {out}/bag/" in done.stdout
+    again = cosim_cli("plot", str(out), "--at", "0.5,1.5")
+    assert again.returncode == 0, again.stderr
+    assert f"wrote {out}/figures/snapshots.png" in again.stdout
 
 
 def test_world_writes_a_picture_a_map_and_an_sdf_world(tmp_path):
