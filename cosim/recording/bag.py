@@ -24,7 +24,7 @@ from rosbags.rosbag2.enums import CompressionFormat, CompressionMode
 from rosbags.rosbag2.storage_mcap import McapWriter
 
 from cosim.errors import ExportError
-from cosim.recording.schemas import ChannelSpec, offered_qos
+from cosim.recording.schemas import ChannelSpec, recorded_qos
 
 if sys.version_info >= (3, 14):  # pragma: no cover
     from compression import zstd
@@ -148,7 +148,7 @@ class BagSink:
                 spec.msgtype,
                 msgdef=spec.msgdef,
                 rihs01=spec.rihs01,
-                offered_qos_profiles=[offered_qos(spec.qos)],
+                offered_qos_profiles=recorded_qos(spec.qos),
             )
             for spec in channels
         ]

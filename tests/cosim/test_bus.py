@@ -1,6 +1,7 @@
 from collections.abc import Sequence
 
 import numpy as np
+import pytest
 
 from cosim.bus import Bus, Envelope
 from cosim.hosts import HostId
@@ -118,3 +119,32 @@ def test_a_message_without_subscribers_goes_nowhere():
     bus.publish("/nobody", Twist(0.0, 0.0), A)
     assert len(recorder.messages_frame()) == 0
     assert bus.published == 1
+
+
+def test_a_monitor_sees_every_publication_without_subscribing_or_adding_a_row():
+    kernel = Kernel()
+    recorder = Recorder()
+    bus = Bus(kernel, FixedDelayLink(5_000_000), tap=recorder)
+    seen: list[tuple[str, HostId, int]] = []
+    bus.monitor("/cmd", lambda topic, _m, src, t_ns: seen.append((topic, src, t_ns)))
+    kernel.every(
+        period_ns(10), lambda now: bus.publish("/cmd", Twist(1.0, 0.0), A), stage=Stage.CONTROL
+    )
+    kernel.run(300_000_000)
+    assert seen == [("/cmd", A, k * 100_000_000) for k in range(3)]
+    assert len(recorder.messages_frame()) == 0  # nobody subscribed: nothing crossed the bus
+    got: list[tuple[int, Message, Envelope]] = []
+    bus.subscribe("/cmd", B, _collect(got, kernel))
+    kernel.run(400_000_000)
+    assert len(seen) == 4
+    assert [t for t, _, _ in got] == [305_000_000]  # the subscriber's copy crossed the link
+    assert len(recorder.messages_frame()) == 1
+
+
+def test_a_topic_advertised_with_two_types_is_refused():
+    bus = Bus(Kernel())
+    bus.advertise("/cmd", Twist)
+    bus.advertise("/cmd", Twist)  # a second publisher of the same type is fine
+    with pytest.raises(ValueError, match="advertised as Twist"):
+        bus.advertise("/cmd", Message)
+    assert list(bus.advertised()) == ["/cmd"]

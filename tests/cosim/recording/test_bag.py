@@ -125,20 +125,20 @@ def test_scans_follow_rep_117_and_match_the_lidar_settings(task_run, task_bag):
     assert not (ranges == lidar.range_max_m).any()
 
 
-def test_latched_topics_are_offered_transient_local_and_scans_best_effort(task_run):
-    meta = yaml.safe_load((task_run.bag / "metadata.yaml").read_text())[
-        "rosbag2_bagfile_information"
-    ]
-    assert meta["version"] == 8
-    assert meta["storage_identifier"] == "mcap"
+def test_latched_topics_are_recorded_transient_local_and_the_others_replay_as_default(task_run):
+    meta = yaml.safe_load((task_run.bag / "metadata.yaml").read_text())
+    info = meta["rosbag2_bagfile_information"]
+    assert info["version"] == 8
+    assert info["storage_identifier"] == "mcap"
     qos = {
-        t["topic_metadata"]["name"]: yaml.safe_load(t["topic_metadata"]["offered_qos_profiles"])[0]
-        for t in meta["topics_with_message_count"]
+        t["topic_metadata"]["name"]: yaml.safe_load(t["topic_metadata"]["offered_qos_profiles"])
+        for t in info["topics_with_message_count"]
     }
     for topic in ("/map", "/tf_static", "/world/markers"):
-        assert qos[topic]["durability"] == 1  # transient local
-    assert qos["/robot_1/scan"]["reliability"] == 2  # best effort
-    assert qos["/robot_1/odom"]["reliability"] == 1  # reliable
+        assert qos[topic][0]["durability"] == 1  # transient local
+        assert qos[topic][0]["reliability"] == 1  # reliable
+    # no profile: `ros2 bag play` offers its default, which every subscriber matches
+    assert qos["/robot_1/scan"] is None and qos["/robot_1/odom"] is None
 
 
 def test_the_default_topics_leave_out_velocity_commands_and_protocol_rounds(task_bag):
@@ -288,3 +288,9 @@ def test_our_bag_and_a_bag_written_by_rosbag2_read_through_one_code_path(task_ru
     # both carry rosbag2's QoS metadata on every channel
     for bag in (ours, theirs):
         assert all("offered_qos_profiles" in meta for meta in bag.channel_metadata.values())
+
+
+def test_the_same_scenario_and_seed_write_byte_identical_bags(task_run, tmp_path):
+    again = cosim.run(task_run.scenario, out=tmp_path / "again")
+    for name in ("bag.mcap", "metadata.yaml"):
+        assert (again.bag / name).read_bytes() == (task_run.bag / name).read_bytes(), name
