@@ -82,7 +82,6 @@ class Kernel:
         self.env: simpy.Environment
         if not speed > 0:
             raise ValueError(f"real-time speed must be > 0, got {speed}")
-        self.realtime = realtime
         if realtime:
             self.env = simpy.rt.RealtimeEnvironment(
                 initial_time=0, factor=1e-9 / speed, strict=False

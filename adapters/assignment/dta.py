@@ -302,15 +302,10 @@ class DtaAdapter:
         self, run: RunContext, robot: RobotTasks, now_ns: int, index: int | None, rounds: int
     ) -> None:
         """Publish the robot's decision on ``/fleet/assignment`` (for tools and bags)."""
-        known = index is not None and index < len(robot.tasks)
-        decision = TaskAssignment(
-            now_ns,
-            robot.epoch,
-            robot.name,
-            robot.tasks[index].task_id if known and index is not None else -1,
-            robot.costs[index] if known and index is not None else math.nan,
-            rounds,
-        )
+        task_id, cost = -1, math.nan
+        if index is not None and index < len(robot.tasks):
+            task_id, cost = robot.tasks[index].task_id, robot.costs[index]
+        decision = TaskAssignment(now_ns, robot.epoch, robot.name, task_id, cost, rounds)
         run.bus.publish(ASSIGNMENT, decision, self.hosts[robot.index])
 
     # -- acting on a decision ------------------------------------------------------------------

@@ -14,7 +14,7 @@ publishes the same on the bus, so a bag or the live view of a run opens in those
 - ``/map`` (nav_msgs/OccupancyGrid of the walls and shelves, latched);
 - ``/world/markers`` (visualization_msgs/MarkerArray, latched): walls, shelves, robot
   footprints riding on their ``base_link``, and the open tasks (orange, green once held),
-  re-published whenever the task source announces a new set.
+  re-published whole whenever the open tasks or their holders change.
 
 It samples on the pose recorder's tick and watches ``/fleet/tasks`` with a bus monitor,
 so it adds no kernel event, no delivery and no table row: a run's tables are the same

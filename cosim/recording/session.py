@@ -59,7 +59,7 @@ class RecordingSession:
 
     Args:
         plan: what to record.
-        topics: the selected topics (:meth:`topics`).
+        topics: the selected topics (:meth:`topics_of`).
         bus: the run's bus.
     """
 
