@@ -192,3 +192,37 @@ def ground_truth_grid(warehouse: Warehouse, resolution_m: float) -> OccupancyGri
         cell free or occupied; robots are not obstacles.
     """
     return rasterize_boxes(warehouse.boxes, warehouse.bounds, resolution_m)
+
+
+def resample(grid: OccupancyGrid, resolution_m: float) -> OccupancyGrid:
+    """The grid at another cell size, keeping obstacles.
+
+    A new cell is occupied when any old cell whose centre it holds is, else free when any
+    of them is free, else unknown. The origin stays; the new grid covers the old one.
+
+    Raises:
+        ModelError: for a resolution that is not a finite number > 0.
+    """
+    if not (math.isfinite(resolution_m) and resolution_m > 0):
+        raise ModelError("resolution_m", resolution_m, "a finite cell size > 0 (m)")
+    rows, cols = grid.data.shape
+    ratio = grid.resolution_m / resolution_m
+    width = max(1, math.ceil(cols * ratio - _SNAP_CELLS))
+    height = max(1, math.ceil(rows * ratio - _SNAP_CELLS))
+    # rank: occupied 2 > free 1 > unknown 0; the highest rank of a cell's sources wins
+    rank = np.where(grid.data >= OCCUPIED, 2, np.where(grid.data == FREE, 1, 0)).astype(np.int8)
+    k = round(1.0 / ratio)
+    if k >= 1 and abs(k * ratio - 1.0) < 1e-9:  # whole blocks of k x k cells: one reshape
+        padded = np.zeros((height * k, width * k), dtype=np.int8)
+        padded[:rows, :cols] = rank
+        best = padded[0::k, 0::k].copy()
+        for dy in range(k):
+            for dx in range(k):
+                np.maximum(best, padded[dy::k, dx::k], out=best)
+    else:
+        col_of = np.minimum(((np.arange(cols) + 0.5) * ratio).astype(np.int64), width - 1)
+        row_of = np.minimum(((np.arange(rows) + 0.5) * ratio).astype(np.int64), height - 1)
+        best = np.zeros((height, width), dtype=np.int8)
+        np.maximum.at(best, (row_of[:, None], col_of[None, :]), rank)
+    data = np.select([best == 2, best == 1], [OCCUPIED, FREE], UNKNOWN).astype(np.int8)
+    return OccupancyGrid(resolution_m, grid.origin_xy_m, data)

@@ -80,18 +80,23 @@ def moving_points(
         points: (m, 2) hits in ``map`` (m), CSR-packed by robot.
         start: (n + 1,) CSR offsets of ``points``.
         poses: (n, 3) robot poses ``x, y, yaw`` in ``map``.
-        static_distance_m: (rows, cols) distance to the nearest static obstacle (m).
+        static_distance_m: (rows, cols) distance to the nearest static obstacle (m), or
+            (n, rows, cols): each robot's own (robots planning on their own maps).
         origin_xy_m: ``map`` position of the grid's lower-left corner (m).
         resolution_m: grid cell size (m).
         params: the rules' parameters.
     """
     owner = np.repeat(np.arange(len(start) - 1), np.diff(start))
     cells = np.floor((points - np.asarray(origin_xy_m)) / resolution_m).astype(np.int64)
-    rows, cols = static_distance_m.shape
+    rows, cols = static_distance_m.shape[-2:]
     inside = (cells[:, 0] >= 0) & (cells[:, 0] < cols) & (cells[:, 1] >= 0)
     inside &= cells[:, 1] < rows
     clear = np.zeros(len(points), dtype=bool)
-    clear[inside] = static_distance_m[cells[inside, 1], cells[inside, 0]] > params.static_margin_m
+    if static_distance_m.ndim == 3:
+        distance = static_distance_m[owner[inside], cells[inside, 1], cells[inside, 0]]
+    else:
+        distance = static_distance_m[cells[inside, 1], cells[inside, 0]]
+    clear[inside] = distance > params.static_margin_m
     owner = owner[clear]
     x, y, yaw = poses[owner].T
     dx, dy = points[clear, 0] - x, points[clear, 1] - y

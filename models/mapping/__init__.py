@@ -1,0 +1,1 @@
+"""Mapping models (the slam_toolbox role): log-odds grids, scan matching, map quality."""
