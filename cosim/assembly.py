@@ -41,6 +41,8 @@ def adapter_names(scenario: Scenario, *, recording: bool = False) -> list[str]:
     names = ["world", "fleet", "network", "collisions"]
     if scenario.lidar.beams > 0:
         names.append("lidar")
+    if scenario.mapping.enabled:
+        names.append("mapping")
     names += DRIVERS[driver] + ["poses"]
     if recording:
         names.append("ros_interface")

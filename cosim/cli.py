@@ -60,6 +60,16 @@ def _non_negative_int(text: str) -> int:
     return value
 
 
+def _non_negative_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not value >= 0 or value == float("inf"):
+        raise argparse.ArgumentTypeError(f"{text} is not a finite number >= 0")
+    return value
+
+
 def _positive_int(text: str) -> int:
     value = _non_negative_int(text)
     if value == 0:
@@ -252,6 +262,50 @@ def build_parser() -> argparse.ArgumentParser:
         "type and message count.",
     )
     info.add_argument("bag", metavar="BAG", type=Path, help="a bag folder, or a .mcap/.db3 file")
+
+    mapping = commands.add_parser(
+        "map",
+        help="map a recorded ROS 2 bag (LaserScan + Odometry) with cosim's mapping",
+        description=(
+            "Run the robots' mapping (scan-to-map matching correcting odometry) on a ROS 2 "
+            "bag (MCAP or sqlite3, a rosbag2 folder or a bare file) and write map.pgm + "
+            "map.yaml, map.png, trajectory.parquet/.csv (t_s, x_m, y_m, yaw_rad) and "
+            "summary.json; with --reference, the trajectory error of odometry and of the "
+            "estimate (RMS after rigid SE(2) alignment)."
+        ),
+    )
+    mapping.add_argument("bag", metavar="BAG", type=Path, help="a bag folder or .mcap/.db3 file")
+    mapping.add_argument("--out", type=Path, required=True, help="output folder")
+    mapping.add_argument("--scan", default="/scan", help="sensor_msgs/LaserScan topic (/scan)")
+    mapping.add_argument("--odom", default="/odom", help="nav_msgs/Odometry topic (/odom)")
+    mapping.add_argument(
+        "--reference",
+        metavar="TOPIC",
+        help="ground-truth poses (Odometry, PoseStamped or PoseWithCovarianceStamped) to "
+        "measure the trajectory error against",
+    )
+    mapping.add_argument(
+        "--resolution-m", type=_positive_float, default=0.05, help="map cell size (0.05 m)"
+    )
+    mapping.add_argument(
+        "--min-travel-m",
+        type=_non_negative_float,
+        default=0.5,
+        help="distance driven before a scan updates the map (slam_toolbox: 0.5 m)",
+    )
+    mapping.add_argument(
+        "--scan-matching",
+        choices=("correlative", "none"),
+        default="correlative",
+        help="correct odometry by scan matching, or none (odometry only, for comparison)",
+    )
+    mapping.add_argument(
+        "--no-loop-closure",
+        action="store_true",
+        help="do not close loops (scan-to-map matching only, as the robots in a run do)",
+    )
+    mapping.add_argument("--force", action="store_true", help="replace results in --out")
+    mapping.add_argument("--quiet", action="store_true", help="no progress line")
 
     plot = commands.add_parser(
         "plot",
@@ -452,6 +506,42 @@ def _cmd_bag(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _cmd_map(args: argparse.Namespace) -> int:
+    from cosim.bagmap import map_bag
+    from models.mapping.slam import UpdateGate
+
+    progress = None if args.quiet else ProgressLine(label=f"{args.bag.name}: ")
+    try:
+        result = map_bag(
+            args.bag,
+            args.out,
+            scan_topic=args.scan,
+            odom_topic=args.odom,
+            reference_topic=args.reference,
+            resolution_m=args.resolution_m,
+            gate=UpdateGate(min_travel_m=args.min_travel_m),
+            scan_matching=args.scan_matching != "none",
+            loop_closure=not args.no_loop_closure,
+            force=args.force,
+            progress=progress,
+        )
+    finally:
+        if progress is not None:
+            progress.close()
+    s = result.summary
+    line = (
+        f"{s['scans']} scans, {s['map_updates']} map updates ({s['matched']} matched, "
+        f"{s['loop_closures']} loop closures), "
+        f"{s['recording_s']:g} s of recording in {s['wall_time_s']:g} s "
+        f"({s['real_time_factor']:g}x real time)"
+    )
+    if "ate_m" in s:
+        line += f"; trajectory error {s['ate_m']:.3f} m (odometry {s['ate_odom_m']:.3f} m)"
+    print(line)
+    print(f"results: {result.out}/  ({', '.join(p.name for p in result.files)})")
+    return EXIT_OK
+
+
 def _cmd_plot(args: argparse.Namespace) -> int:
     from cosim.plotting.command import plot_run
 
@@ -474,6 +564,7 @@ COMMANDS = {
     "world": _cmd_world,
     "study": _cmd_study,
     "bag": _cmd_bag,
+    "map": _cmd_map,
     "plot": _cmd_plot,
     "scenarios": _cmd_scenarios,
 }

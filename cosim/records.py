@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping, Sequence
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 import numpy.typing as npt
@@ -19,6 +19,31 @@ import pandas as pd
 from cosim.hosts import HostId
 from cosim.link import DeliveryStatus
 from cosim.timebase import NS_PER_S
+
+
+class MapArtifact(Protocol):
+    """An occupancy map an adapter hands over for the run folder (``maps/NAME.pgm``/``.yaml``).
+
+    Attributes:
+        resolution_m: cell size (m).
+        origin_xy_m: ``map`` position of the lower-left corner of cell (0, 0) (m).
+        data: (rows, cols) int8 cells, row 0 at the lowest y: 0 free, 100 occupied, -1 unknown.
+    """
+
+    @property
+    def resolution_m(self) -> float:
+        """Cell size (m)."""
+        ...
+
+    @property
+    def origin_xy_m(self) -> tuple[float, float]:
+        """Lower-left corner of cell (0, 0) in ``map`` (m)."""
+        ...
+
+    @property
+    def data(self) -> npt.NDArray[np.int8]:
+        """The cells."""
+        ...
 
 
 class _Interner:
@@ -133,6 +158,7 @@ class Recorder:
         self._events = Table(("t_ns", "source", "kind", "detail"))
         self.tables: dict[str, Table] = {}
         self.volatile: dict[str, tuple[str, ...]] = {}
+        self.maps: dict[str, MapArtifact] = {}
         self.counts: dict[str, int] = {status.value: 0 for status in DeliveryStatus}
         self.network_messages = 0
         self.network_bytes = 0
@@ -212,6 +238,12 @@ class Recorder:
                 raise ValueError(f"volatile column {column!r} is not a column of {name!r}")
         self.volatile[name] = tuple(volatile)
         return table
+
+    def add_map(self, name: str, grid: MapArtifact) -> None:
+        """Keep a final map for the run folder (``maps/NAME``)."""
+        if name in self.maps:
+            raise ValueError(f"map {name!r} exists already")
+        self.maps[name] = grid
 
     # -- export ----------------------------------------------------------------------
     def messages_frame(self) -> pd.DataFrame:

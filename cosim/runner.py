@@ -18,16 +18,18 @@ from cosim.assembly import Assembly, assemble
 from cosim.errors import ExportError
 from cosim.recording.live import LiveOptions
 from cosim.recording.session import RecordingPlan, RecordingSession
-from cosim.records import merge_counts
+from cosim.records import MapArtifact, merge_counts
 from cosim.registry import AdapterRegistry
 from cosim.scenario.loader import dump_scenario
 from cosim.scenario.model import Scenario
 from cosim.timebase import NS_PER_S, s_to_ns
+from cosim.worldfiles import write_map
+from models.occupancy import OccupancyGrid
 
 ProgressFn = Callable[[float, float, float], None]
 """Progress callback: (sim time s, duration s, wall time s)."""
 
-OUTPUTS = ("summary.json", "scenario.toml", "tables", "figures", "bag")
+OUTPUTS = ("summary.json", "scenario.toml", "tables", "figures", "bag", "maps")
 """What a run writes into its folder (``--force`` removes exactly these)."""
 
 
@@ -42,6 +44,7 @@ class RunResult:
         out: the run folder, when written.
         bag: the bag directory, when one was written.
         recorded: messages recorded per topic (bag or live view).
+        maps: final occupancy maps by name (written as ``maps/NAME.yaml`` + ``.pgm``).
     """
 
     scenario: Scenario
@@ -51,6 +54,7 @@ class RunResult:
     volatile: dict[str, tuple[str, ...]] = field(default_factory=dict, repr=False)
     bag: Path | None = None
     recorded: dict[str, int] = field(default_factory=dict, repr=False)
+    maps: dict[str, MapArtifact] = field(default_factory=dict, repr=False)
 
     def deterministic_tables(self) -> dict[str, pd.DataFrame]:
         """The tables without their wall-clock columns: equal for equal scenario and seed."""
@@ -161,7 +165,13 @@ def _run_assembled(
             merge_counts(summary, adapter.finish(run))
         except ValueError as error:
             raise RuntimeError(f"adapter {name!r}: {error}") from error
-    return RunResult(scenario, summary, run.recorder.frames(), volatile=run.recorder.volatile)
+    return RunResult(
+        scenario,
+        summary,
+        run.recorder.frames(),
+        volatile=run.recorder.volatile,
+        maps=dict(run.recorder.maps),
+    )
 
 
 def prepare_out(out: Path, *, force: bool) -> None:
@@ -196,6 +206,11 @@ def write_run(result: RunResult, out: Path, *, tables: bool = True) -> None:
             (partial / "tables").mkdir()
             for name, frame in result.tables.items():
                 frame.to_parquet(partial / "tables" / f"{name}.parquet", index=False)
+        for name, grid in result.maps.items():
+            write_map(
+                OccupancyGrid(grid.resolution_m, grid.origin_xy_m, grid.data),
+                partial / "maps" / f"{name}.yaml",
+            )
         (partial / "summary.json").write_text(
             json.dumps(result.summary, indent=2, allow_nan=False) + "\n", encoding="utf-8"
         )

@@ -31,7 +31,6 @@ import numpy.typing as npt
 import yaml
 
 from cosim.errors import ConfigError, ExportError, ScenarioError
-from cosim.plotting.world import world_figure
 from cosim.rng import RngStreams
 from cosim.scenario.model import Scenario
 from models.errors import ModelError
@@ -368,6 +367,8 @@ def world_command(
             ) from None
     written: list[Path] = []
     if png is not None:
+        from cosim.plotting.world import world_figure  # matplotlib: only when drawing
+
         title = f"{scenario.name} (seed {scenario.seed})"
         written.append(
             world_figure(warehouse, Path(png), title=title, robot_radius_m=scenario.robots.radius_m)

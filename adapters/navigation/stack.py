@@ -26,7 +26,9 @@ from typing import Any, ClassVar
 import numpy as np
 
 from adapters.fleet.motion import drive_limits
+from adapters.mapping.geometry import map_geometry, unknown_grid
 from adapters.naming import topic
+from adapters.navigation.layers import StaticLayers
 from adapters.navigation.records import NavRecords
 from adapters.navigation.recovery import Recovery
 from adapters.navigation.scan_memory import MovingMemory, ScanMemory
@@ -43,11 +45,14 @@ from cosim.messages import (
     Odometry,
     Path,
     RobotState,
+    TFMessage,
     Twist,
 )
+from cosim.messages import OccupancyGrid as GridMessage
 from cosim.timebase import NS_PER_S, period_ns, s_to_ns
 from models.kinematics import FleetState
 from models.lidar import ScanGeometry
+from models.mapping.se2 import compose
 from models.navigation.costmap import CostmapParams, StaticCostmap, with_obstacles
 from models.navigation.dwa import DwaParams, dwa_batch
 from models.navigation.follow import PathBook, paths_blocked
@@ -109,6 +114,16 @@ class NavigationAdapter:
         self.params = CostmapParams(radius, cfg.inflation_radius_m, cfg.cost_scaling)
         self.static = StaticCostmap.from_grid(run.service(StaticLayer).grid, self.params)
         run.provide(self.static)
+        self.mapping = run.scenario.mapping.enabled
+        if self.mapping:
+            area = map_geometry(run.service(Warehouse), run.scenario.mapping.resolution_m)
+            self.layers = StaticLayers.unexplored(
+                unknown_grid(area), len(self.names), self.params, cfg.resolution_m
+            )
+        else:
+            self.layers = StaticLayers.shared(self.static, len(self.names))
+        self.correction = [(0.0, 0.0, 0.0)] * len(self.names)
+        """Per robot ``map -> odom`` from its mapping (identity without mapping)."""
         self.limits = drive_limits(run)
         self.dwa = DwaParams(control_period_s=1.0 / cfg.control_hz)
         self.period_ns = period_ns(cfg.control_hz)
@@ -155,6 +170,9 @@ class NavigationAdapter:
             bus.subscribe(topic(name, "nav/goal"), host, self._on_goal(run, i))
             bus.subscribe(topic(name, "odom"), host, self._on_odom(i))
             bus.subscribe(topic(name, "scan"), host, self._on_scan(i))
+            if self.mapping:
+                bus.subscribe(topic(name, "tf"), host, self._on_correction(i))
+                bus.subscribe(topic(name, "map"), host, self._on_map(i))
         kernel = run.kernel
         kernel.every(self.period_ns, lambda now: self._control(run, now), stage=Stage.CONTROL)
         kernel.every(
@@ -174,10 +192,28 @@ class NavigationAdapter:
     def _on_odom(self, i: int) -> Callable[[Message, Envelope], None]:
         def on_odom(message: Message, _envelope: Envelope) -> None:
             assert isinstance(message, Odometry)
-            self.pose[i] = (message.x_m, message.y_m, message.yaw_rad)
+            odom = (message.x_m, message.y_m, message.yaw_rad)
+            # localized: the mapping's map -> odom correction applied to odometry
+            self.pose[i] = compose(self.correction[i], odom) if self.mapping else odom
             self.vel[i] = (message.v_mps, message.w_radps)
 
         return on_odom
+
+    def _on_correction(self, i: int) -> Callable[[Message, Envelope], None]:
+        def on_tf(message: Message, _envelope: Envelope) -> None:
+            assert isinstance(message, TFMessage)
+            for t in message.transforms:
+                if t.parent == "map":
+                    self.correction[i] = (t.x_m, t.y_m, t.yaw_rad)
+
+        return on_tf
+
+    def _on_map(self, i: int) -> Callable[[Message, Envelope], None]:
+        def on_map(message: Message, _envelope: Envelope) -> None:
+            assert isinstance(message, GridMessage)
+            self.layers.update(i, message)
+
+        return on_map
 
     def _on_scan(self, i: int) -> Callable[[Message, Envelope], None]:
         def on_scan(message: Message, _envelope: Envelope) -> None:
@@ -245,7 +281,9 @@ class NavigationAdapter:
         where = goal_status(self.static, (goal.x_m, goal.y_m))
         shortest = math.inf
         if where is GoalStatus.OK:
-            shortest = shortest_path_length_m(self.static, self.pose[i, :2], (goal.x_m, goal.y_m))
+            # on the true map from the true position: the yardstick of path_length_ratio
+            truth = (float(self.fleet.x[i]), float(self.fleet.y[i]))
+            shortest = shortest_path_length_m(self.static, truth, (goal.x_m, goal.y_m))
         if not math.isfinite(shortest):
             detail = where.value if where is not GoalStatus.OK else "enclosed"
             self._drop(run, i, "unreachable", detail)
@@ -268,8 +306,9 @@ class NavigationAdapter:
         self._status(run, i, state, math.nan)
 
     def _obstacles_for_plan(self, i: int, now_ns: int) -> tuple[np.ndarray, np.ndarray]:
-        points = self.moving.recall(i, self.static.resolution_m)
-        points = points[~self.memory.seen_through(i, points, 2 * self.static.resolution_m)]
+        res = self.layers.resolution_m
+        points = self.moving.recall(i, res)
+        points = points[~self.memory.seen_through(i, points, 2 * res)]
         discs = self._discs(i, now_ns)
         return points, discs
 
@@ -281,20 +320,21 @@ class NavigationAdapter:
     def _plan(self, run: RunContext, i: int, now_ns: int, *, replan: bool) -> bool:
         start = time.perf_counter()
         points, discs = self._obstacles_for_plan(i, now_ns)
-        cost = with_obstacles(self.static, points, discs=discs if len(discs) else None)
-        s_cell = self.static.world_to_cell(self.pose[i, :2])
-        g_cell = self.static.world_to_cell(self.goal[i])
-        result = plan(cost, s_cell, g_cell, resolution_m=self.static.resolution_m)
+        layer = self.layers[i]
+        cost = with_obstacles(layer, points, discs=discs if len(discs) else None)
+        s_cell = layer.world_to_cell(self.pose[i, :2])
+        g_cell = layer.world_to_cell(self.goal[i])
+        result = plan(cost, s_cell, g_cell, resolution_m=layer.resolution_m)
         detail = ""
         if not result.found:
             # as Nav2's "clear costmap" recovery does: plan on the static layer alone, and
             # leave the robots and people in the way to the local controller
             detail = "cleared"
-            cost = self.static.cost
-            result = plan(cost, s_cell, g_cell, resolution_m=self.static.resolution_m)
+            cost = layer.cost
+            result = plan(cost, s_cell, g_cell, resolution_m=layer.resolution_m)
         if result.found:
             cells = prune_path(cost, result.cells)
-            waypoints = path_to_world(self.static, cells)
+            waypoints = path_to_world(layer, cells)
             waypoints[-1] = self.goal[i]
             self.paths.set(i, waypoints)
             # Nav2's planner publishes every plan it makes on `plan` (for tools; nothing here
@@ -332,14 +372,14 @@ class NavigationAdapter:
         # sender answers the status synchronously), which the rest of the tick then follows
         self._check_arrivals(run, now_ns)
         points, start = self.memory.near(self.near_m)
-        static = self.static
+        layers = self.layers
         moving = moving_points(
             points,
             start,
             self.pose,
-            static.distance_m,
-            static.origin_xy_m,
-            static.resolution_m,
+            layers.distance,
+            layers.origin_xy_m,
+            layers.resolution_m,
             self.traffic,
         )
         self.moving.remember(now_ns, moving.owner, moving.points)

@@ -13,6 +13,7 @@ Frames follow REP 105: ``map`` (fixed world frame), ``odom`` (drifting, continuo
 from cosim.messages.assignment import AuctionBids, SimplexBasis, TaskAssignment, TaskOrder
 from cosim.messages.base import Message
 from cosim.messages.frames import Clock, TFMessage, Transform
+from cosim.messages.mapping import LocalizedScan, MapUpdate
 from cosim.messages.navigation import NavGoal, NavStatus, RobotState
 from cosim.messages.ros import Goal, LaserScan, Odometry, Path, PoseStamped, Twist
 from cosim.messages.scene import Marker, MarkerAction, MarkerArray, MarkerType, OccupancyGrid
@@ -30,6 +31,8 @@ __all__ = [
     "Clock",
     "Goal",
     "LaserScan",
+    "LocalizedScan",
+    "MapUpdate",
     "Marker",
     "MarkerAction",
     "MarkerArray",

@@ -95,6 +95,30 @@ string robot
 int32 task_id
 float64 cost
 """,
+    "cosim_msgs/msg/LocalizedScan": """
+std_msgs/Header header
+string robot
+float64 x
+float64 y
+float64 yaw
+float32 angle_min
+float32 angle_increment
+float32 range_min
+float32 range_max
+float32[] ranges
+""",
+    "cosim_msgs/msg/MapUpdate": """
+std_msgs/Header header
+string robot
+uint32 seq
+int32 ix0
+int32 iy0
+uint32 width
+uint32 height
+float32 scale
+string encoding
+uint8[] data
+""",
     "cosim_msgs/msg/TaskAssignment": """
 std_msgs/Header header
 uint32 epoch

@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, fields, replace
 from typing import Any, get_type_hints
 
+from cosim.scenario.mapping import MappingConfig
 from cosim.scenario.network import NetworkConfig
 from cosim.scenario.sections import (
     AssignmentConfig,
@@ -36,6 +37,7 @@ class Scenario:
     navigation: NavigationConfig = field(default_factory=NavigationConfig)
     tasks: TasksConfig = field(default_factory=TasksConfig)
     assignment: AssignmentConfig = field(default_factory=AssignmentConfig)
+    mapping: MappingConfig = field(default_factory=MappingConfig)
     record: RecordConfig = field(default_factory=RecordConfig)
     source: str = field(default="<defaults>", compare=False)
 

@@ -6,6 +6,7 @@ from pathlib import Path
 
 from cosim.analysis import FIGURES_DIR, heatmap, load_results, standard_figures, write_report
 from cosim.studies.spec import StudySpec
+from cosim.studies.timeseries import timeseries_figures
 
 DEFAULT_METRICS = (
     "tasks_per_min",
@@ -34,6 +35,8 @@ def report_study(spec: StudySpec, out: Path) -> Path:
             if metric in ok.columns and ok[metric].notna().any():
                 target = out / FIGURES_DIR / f"{metric}_over_{x}_and_{facet}.png"
                 figures.append(heatmap(ok, x=x, y=facet, metric=metric, facet=hue, out=target))
+    for entry in report.get("timeseries", []):
+        figures += timeseries_figures(out, entry, x=x, hue=hue, facet=facet)
     return write_report(
         out,
         name=spec.name,

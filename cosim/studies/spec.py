@@ -48,7 +48,8 @@ from cosim.scenario.loader import preset_names
 
 SECTIONS = ("study", "grid", "overrides", "cases", "report")
 STUDY_KEYS = ("name", "scenario", "seeds", "duration_s", "tables", "description")
-REPORT_KEYS = ("x", "hue", "facet", "metrics", "heatmaps")
+REPORT_KEYS = ("x", "hue", "facet", "metrics", "heatmaps", "timeseries")
+TIMESERIES_KEYS = ("table", "y", "where")
 
 
 @dataclass(frozen=True)
@@ -200,6 +201,7 @@ def load_study(path: str | Path) -> StudySpec:
         raise _fail(path, "report", "expected a table")
     _check_keys(path, "report", report, REPORT_KEYS)
     _check_report(path, report, grid, overrides, cases)
+    _check_timeseries(path, report.get("timeseries", []), tables)
     spec = StudySpec(
         path=path,
         name=study["name"],
@@ -275,6 +277,32 @@ def _check_report(
             raise _fail(path, "report", f"{key} = {value!r}: expected a list of metric names")
     if report.get("heatmaps") and not ("x" in report and "facet" in report):
         raise _fail(path, "report", "heatmaps need x and facet (the heatmap's columns and rows)")
+
+
+def _check_timeseries(path: Path, entries: Any, tables: tuple[str, ...]) -> None:
+    """Each ``[report] timeseries`` entry names a kept table, a column and a filter."""
+    if not isinstance(entries, list) or not all(isinstance(e, dict) for e in entries):
+        raise _fail(path, "report", f"timeseries = {entries!r}: expected a list of tables")
+    for i, entry in enumerate(entries):
+        _check_keys(path, f"report.timeseries[{i}]", entry, TIMESERIES_KEYS)
+        table, y, where = entry.get("table"), entry.get("y"), entry.get("where", {})
+        if not isinstance(table, str) or not isinstance(y, str) or not table or not y:
+            raise _fail(
+                path, f"report.timeseries[{i}]", f"table = {table!r}, y = {y!r}: expected names"
+            )
+        if "*" not in tables and table not in tables:
+            raise _fail(
+                path,
+                f"report.timeseries[{i}]",
+                f"table = {table!r}: expected one the study keeps ([study] tables = "
+                f"{list(tables)!r})",
+            )
+        if not isinstance(where, dict) or not all(
+            isinstance(v, str | int | float | bool) for v in where.values()
+        ):
+            raise _fail(
+                path, f"report.timeseries[{i}]", f"where = {where!r}: expected column = value"
+            )
 
 
 def _validate_combinations(spec: StudySpec) -> None:

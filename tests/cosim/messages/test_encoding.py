@@ -12,6 +12,8 @@ from cosim.messages import (
     Clock,
     Goal,
     LaserScan,
+    LocalizedScan,
+    MapUpdate,
     Marker,
     MarkerAction,
     MarkerArray,
@@ -86,6 +88,8 @@ EXAMPLES: list[Message] = [
     ),
     TFMessage(22, ()),
     OccupancyGrid(23, "map", 0.05, 3, 2, -0.2, -0.2, bytes([0, 100, 255, 0, 0, 100])),
+    LocalizedScan(25, "robot_3", 1.0, 2.0, 0.5, -3.1, 0.0175, 0.1, 10.0, np.ones(7, dtype="f4")),
+    MapUpdate(26, "robot_2", 4, 10, -3, 20, 5, 0.05, bytes(range(17))),
     MarkerArray(
         24,
         (

@@ -1,0 +1,1 @@
+"""Mapping on every robot (the slam_toolbox role): maps, pose correction, sharing, quality."""

@@ -1,0 +1,313 @@
+"""The mapping adapter: every robot maps as it drives and corrects its odometry (slam_toolbox).
+
+On each robot's host, its scans and odometry go through a :class:`~models.mapping.slam.ScanMapper`
+(update gate, correlative matching, log-odds map). After every map update the robot
+publishes its ``map -> robot_i/odom`` correction on ``/robot_i/tf`` (namespaced tf, as
+Nav2's multi-robot bringup remaps it), which its navigation composes with odometry to
+localize; every ``mapping.map_update_interval_s`` it publishes its map on
+``/robot_i/map`` (nav_msgs/OccupancyGrid), which its navigation plans on, as
+slam_toolbox's ``/map`` feeds Nav2's static layer.
+
+Sharing (``mapping.share``), over the network model like any message: ``scans`` sends
+every mapped scan with its estimated pose on ``/fleet/mapping/scans`` and a neighbour
+adds it to its map at that pose; ``maps`` sends, every ``mapping.share_period_s``, the
+log-odds the robot's own scans added since its last update, compressed
+(:mod:`models.mapping.exchange`), on ``/fleet/mapping/updates``. Robots start with known
+poses in the common ``map`` frame. A lost message is not sent again: its evidence is
+lost, as with slam_toolbox.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from typing import Any, ClassVar
+
+import numpy as np
+
+from adapters.mapping.geometry import map_geometry
+from adapters.mapping.records import MappingRecords
+from adapters.naming import topic
+from cosim.adapter import RunContext
+from cosim.bus import Envelope, TopicQos
+from cosim.hosts import BASE_HOST, HostId
+from cosim.kernel import Stage
+from cosim.messages import (
+    LaserScan,
+    LocalizedScan,
+    MapUpdate,
+    Message,
+    OccupancyGrid,
+    Odometry,
+    TFMessage,
+    Transform,
+)
+from cosim.scenario.mapping import MappingConfig
+from cosim.timebase import period_ns
+from models.errors import ModelError
+from models.kinematics import FleetState
+from models.lidar import ScanGeometry
+from models.mapping.exchange import PackedUpdate, pack, unpack
+from models.mapping.grid import LogOddsMap, Scratch
+from models.mapping.matcher import MatcherParams
+from models.mapping.slam import MapperParams, ScanMapper, UpdateGate
+from models.world import Warehouse
+
+SCANS = "/fleet/mapping/scans"
+UPDATES = "/fleet/mapping/updates"
+FLEET_MAP = "/fleet/map"
+
+
+def mapper_params(cfg: MappingConfig, lidar_min_m: float, lidar_max_m: float) -> MapperParams:
+    """The model parameters of ``[mapping]`` for a lidar's valid ranges."""
+    return MapperParams(
+        gate=UpdateGate(cfg.min_travel_m, cfg.min_heading_rad, cfg.min_interval_s),
+        matcher=MatcherParams(window_m=cfg.search_window_m, window_rad=cfg.search_window_rad),
+        scan_matching=cfg.scan_matching != "none",
+        range_min_m=lidar_min_m,
+        range_max_m=lidar_max_m,
+        clear_no_return_m=cfg.clear_no_return_m,
+    )
+
+
+def grid_message(t_ns: int, grid: LogOddsMap) -> OccupancyGrid:
+    """A map as the nav_msgs/OccupancyGrid slam_toolbox publishes."""
+    g = grid.geometry
+    return OccupancyGrid(
+        t_ns,
+        "map",
+        g.resolution_m,
+        g.width,
+        g.height,
+        g.origin_xy_m[0],
+        g.origin_xy_m[1],
+        grid.occupancy().tobytes(),
+    )
+
+
+class MappingAdapter:
+    """Maps, pose corrections and map sharing of every robot."""
+
+    name: ClassVar[str] = "mapping"
+    requires: ClassVar[tuple[str, ...]] = ("world", "fleet", "lidar", "network")
+
+    def __init__(self, run: RunContext) -> None:
+        self.cfg = run.scenario.mapping
+        world = run.service(Warehouse)
+        self.fleet = run.service(FleetState)
+        self.names = list(self.fleet.names)
+        self.hosts = [HostId(n) for n in self.names]
+        lidar = run.scenario.lidar
+        self.angles = ScanGeometry(
+            lidar.beams, math.radians(lidar.fov_deg), lidar.range_min_m, lidar.range_max_m
+        ).angles()
+        self.geometry = map_geometry(world, self.cfg.resolution_m)
+        scratch = Scratch(self.geometry)
+        track = self.cfg.share == "maps"
+        self.maps = [
+            LogOddsMap(self.geometry, scratch=scratch, track_changes=track) for _ in self.names
+        ]
+        self.fleet_map = LogOddsMap(self.geometry, scratch=scratch)
+        self.params = mapper_params(self.cfg, lidar.range_min_m, lidar.range_max_m)
+        self.mappers = [
+            ScanMapper(grid, (float(x), float(y), float(yaw)), self.params, self.angles)
+            for grid, (x, y, yaw) in zip(self.maps, world.starts, strict=True)
+        ]
+        self.odom = [(float(x), float(y), float(yaw)) for x, y, yaw in world.starts]
+        self.seq = [0] * len(self.names)
+        self.records = MappingRecords(run.recorder, self.names, world, self.geometry)
+        self.tf_topics = [topic(n, "tf") for n in self.names]
+        self.map_topics = [topic(n, "map") for n in self.names]
+        bus = run.bus
+        for tf, grid in zip(self.tf_topics, self.map_topics, strict=True):
+            bus.advertise(tf, TFMessage)
+            bus.advertise(grid, OccupancyGrid, TopicQos.LATCHED)
+        bus.advertise(FLEET_MAP, OccupancyGrid, TopicQos.LATCHED)
+        if self.cfg.share == "scans":
+            bus.advertise(SCANS, LocalizedScan, TopicQos.SENSOR)
+        elif self.cfg.share == "maps":
+            bus.advertise(UPDATES, MapUpdate)
+        self.recorder = run.recorder
+
+    # -- wiring ----------------------------------------------------------------------
+    def start(self, run: RunContext) -> None:
+        """Follow every robot's odometry and scans; start publishing and sampling."""
+        bus = run.bus
+        for i, (name, host) in enumerate(zip(self.names, self.hosts, strict=True)):
+            bus.subscribe(topic(name, "odom"), host, self._on_odom(i))
+            bus.subscribe(topic(name, "scan"), host, self._on_scan(run, i))
+            if self.cfg.share == "scans":
+                bus.subscribe(SCANS, host, self._on_shared_scan(run, i))
+            elif self.cfg.share == "maps":
+                bus.subscribe(UPDATES, host, self._on_update(run, i))
+        kernel = run.kernel
+        interval = period_ns(1.0 / self.cfg.map_update_interval_s)
+        kernel.every(
+            interval,
+            lambda now: self._publish_maps(run, now),
+            stage=Stage.CONTROL,
+            start_ns=kernel.now_ns + interval,
+        )
+        if self.cfg.share == "maps":
+            share = period_ns(1.0 / self.cfg.share_period_s)
+            kernel.every(
+                share,
+                lambda now: self._share_maps(run, now),
+                stage=Stage.CONTROL,
+                start_ns=kernel.now_ns + share,
+            )
+        quality = period_ns(1.0 / self.cfg.quality_period_s)
+        kernel.every(quality, self._sample, stage=Stage.RECORD, start_ns=kernel.now_ns + quality)
+
+    def _on_odom(self, i: int) -> Callable[[Message, Envelope], None]:
+        def on_odom(message: Message, _envelope: Envelope) -> None:
+            assert isinstance(message, Odometry)
+            self.odom[i] = (message.x_m, message.y_m, message.yaw_rad)
+
+        return on_odom
+
+    def _on_scan(self, run: RunContext, i: int) -> Callable[[Message, Envelope], None]:
+        def on_scan(message: Message, _envelope: Envelope) -> None:
+            assert isinstance(message, LaserScan)
+            self._scan(run, i, message)
+
+        return on_scan
+
+    # -- a robot's own scans ---------------------------------------------------------------
+    def _scan(self, run: RunContext, i: int, scan: LaserScan) -> None:
+        now = run.kernel.now_ns
+        odom = self.odom[i]
+        # the fleet's bookkeeping map takes the scan in the same pass as the robot's map
+        update = self.mappers[i].process(now, odom, scan.ranges_m, also=self.fleet_map)
+        if update is None:
+            return
+        fleet = self.fleet
+        truth = (float(fleet.x[i]), float(fleet.y[i]))
+        self.records.update(
+            now, i, update.pose, truth, (odom[0], odom[1]), update.score, update.matched
+        )
+        correction = self.mappers[i].correction
+        name = self.names[i]
+        tf = TFMessage(now, (Transform("map", f"{name}/odom", *correction),))
+        run.bus.publish(self.tf_topics[i], tf, self.hosts[i])
+        if self.cfg.share == "scans":
+            x, y, yaw = update.pose
+            shared = LocalizedScan(
+                now,
+                name,
+                x,
+                y,
+                yaw,
+                scan.angle_min_rad,
+                scan.angle_increment_rad,
+                scan.range_min_m,
+                scan.range_max_m,
+                scan.ranges_m,
+            )
+            self.records.shared(shared.size_bytes())
+            run.bus.publish(SCANS, shared, self.hosts[i])
+
+    # -- neighbours' evidence -------------------------------------------------------------
+    def _on_shared_scan(self, run: RunContext, i: int) -> Callable[[Message, Envelope], None]:
+        me = self.names[i]
+
+        def on_scan(message: Message, envelope: Envelope) -> None:
+            assert isinstance(message, LocalizedScan)
+            if message.robot == me:
+                return
+            angles = message.angle_min_rad + message.angle_increment_rad * np.arange(
+                len(message.ranges_m), dtype=np.float64
+            )
+            cells = self.maps[i].integrate(
+                (message.x_m, message.y_m, message.yaw_rad),
+                angles,
+                message.ranges_m,
+                range_min_m=message.range_min_m,
+                range_max_m=message.range_max_m,
+                clear_no_return_m=self.params.clear_no_return_m,
+            )
+            self.records.merge(
+                run.kernel.now_ns,
+                i,
+                message.robot,
+                "scan",
+                message.size_bytes(),
+                message.stamp_ns,
+                cells,
+            )
+
+        return on_scan
+
+    def _share_maps(self, run: RunContext, now_ns: int) -> None:
+        for i, grid in enumerate(self.maps):
+            changes = grid.take_changes()
+            packed = pack(changes) if changes is not None else None
+            if packed is None:
+                continue
+            self.seq[i] += 1
+            update = MapUpdate(
+                now_ns,
+                self.names[i],
+                self.seq[i],
+                packed.ix0,
+                packed.iy0,
+                packed.width,
+                packed.height,
+                packed.scale,
+                packed.data,
+            )
+            self.records.shared(update.size_bytes())
+            run.bus.publish(UPDATES, update, self.hosts[i])
+
+    def _on_update(self, run: RunContext, i: int) -> Callable[[Message, Envelope], None]:
+        me = self.names[i]
+        grid = self.maps[i]
+        shape = (self.geometry.height, self.geometry.width)
+
+        def on_update(message: Message, envelope: Envelope) -> None:
+            assert isinstance(message, MapUpdate)
+            if message.robot == me:
+                return
+            packed = PackedUpdate(
+                message.ix0,
+                message.iy0,
+                message.width,
+                message.height,
+                message.scale,
+                message.data,
+            )
+            try:
+                block = unpack(packed, shape)
+            except ModelError as error:  # a malformed update is ignored, and counted
+                run.recorder.event(run.kernel.now_ns, me, "map_update_refused", str(error))
+                return
+            cells = grid.add_logodds(message.iy0, message.ix0, block)
+            self.records.merge(
+                run.kernel.now_ns,
+                i,
+                message.robot,
+                "map",
+                message.size_bytes(),
+                message.stamp_ns,
+                cells,
+            )
+
+        return on_update
+
+    # -- maps out --------------------------------------------------------------------------
+    def _publish_maps(self, run: RunContext, now_ns: int) -> None:
+        bus = run.bus
+        for grid, name, host in zip(self.maps, self.map_topics, self.hosts, strict=True):
+            bus.publish(name, grid_message(now_ns, grid), host)
+        bus.publish(FLEET_MAP, grid_message(now_ns, self.fleet_map), BASE_HOST)
+
+    def _sample(self, now_ns: int) -> None:
+        self.records.sample(now_ns, self.maps, self.fleet_map)
+
+    def finish(self, run: RunContext) -> Mapping[str, Any]:
+        """Final quality, errors and sharing; the final maps for the run folder."""
+        self.records.sample(run.kernel.now_ns, self.maps, self.fleet_map)
+        for name, grid in zip(self.names, self.maps, strict=True):
+            self.recorder.add_map(name, grid.occupancy_grid())
+        self.recorder.add_map("fleet", self.fleet_map.occupancy_grid())
+        return self.records.summary()

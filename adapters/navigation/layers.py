@@ -1,0 +1,79 @@
+"""The static layer each robot plans on: the building's map, or the map the robot builds.
+
+Without mapping every robot plans on the ground-truth map, inflated once and shared. With
+``mapping.enabled`` each robot starts knowing nothing and plans on its own map as it
+arrives on ``/robot_i/map`` (slam_toolbox's ``/map`` feeding Nav2's static layer):
+resampled to the costmap's cell size keeping every obstacle, with unknown cells
+traversable (Nav2's ``allow_unknown``: a robot plans into unexplored space and its lidar
+and replanning take it from there), then inflated. Every robot's distance-to-obstacle
+grid is kept in one stack so that the traffic rules stay one batched call.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+
+from cosim.messages import OccupancyGrid as GridMessage
+from models.navigation.costmap import CostmapParams, StaticCostmap
+from models.occupancy import FREE, UNKNOWN, OccupancyGrid, resample
+
+
+class StaticLayers:
+    """Each robot's static costmap and their distance grids.
+
+    Args:
+        layers: one costmap per robot (the same object for all when shared).
+        stacked: keep a (robots, rows, cols) stack of distances (own maps), else the first
+            layer's distances serve every robot.
+    """
+
+    def __init__(self, layers: list[StaticCostmap], *, stacked: bool) -> None:
+        self.layers = layers
+        first = layers[0]
+        self.resolution_m = first.resolution_m
+        self.origin_xy_m = first.origin_xy_m
+        self.params = first.params
+        self.distance: npt.NDArray[np.float32] = (
+            np.stack([layer.distance_m for layer in layers]) if stacked else first.distance_m
+        )
+        self.updates = 0
+
+    @classmethod
+    def shared(cls, static: StaticCostmap, robots: int) -> StaticLayers:
+        """Every robot plans on the same map."""
+        return cls([static] * robots, stacked=False)
+
+    @classmethod
+    def unexplored(
+        cls, grid: OccupancyGrid, robots: int, params: CostmapParams, resolution_m: float
+    ) -> StaticLayers:
+        """Each robot starts with an empty map covering ``grid``'s area."""
+        empty = _traversable(resample(grid, resolution_m))
+        layer = StaticCostmap.from_grid(empty, params)
+        return cls([layer] * robots, stacked=True)
+
+    def __getitem__(self, robot: int) -> StaticCostmap:
+        return self.layers[robot]
+
+    def update(self, robot: int, message: GridMessage) -> None:
+        """A robot's new map: resample, make unknown traversable, inflate, restack."""
+        cells = np.frombuffer(message.data, dtype=np.int8).reshape(message.height, message.width)
+        grid = OccupancyGrid(message.resolution_m, (message.origin_x_m, message.origin_y_m), cells)
+        layer = StaticCostmap.from_grid(
+            _traversable(resample(grid, self.resolution_m)), self.params
+        )
+        if layer.cost.shape != self.layers[robot].cost.shape:
+            raise ValueError(
+                f"map of {message.width} x {message.height} cells does not cover the same "
+                f"area as robot {robot}'s costmap"
+            )
+        self.layers[robot] = layer
+        self.distance[robot] = layer.distance_m
+        self.updates += 1
+
+
+def _traversable(grid: OccupancyGrid) -> OccupancyGrid:
+    """Unknown cells as free (Nav2's ``allow_unknown``)."""
+    data = np.where(grid.data == UNKNOWN, FREE, grid.data).astype(np.int8)
+    return OccupancyGrid(grid.resolution_m, grid.origin_xy_m, data)

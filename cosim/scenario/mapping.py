@@ -1,0 +1,60 @@
+"""The ``[mapping]`` section: every robot maps as it drives (the slam_toolbox role).
+
+Defaults follow slam_toolbox's (``minimum_travel_distance`` 0.5 m,
+``minimum_travel_heading`` 0.5 rad, ``minimum_time_interval`` 0.5 s,
+``map_update_interval`` 5 s, 0.05 m resolution) unless said otherwise; the log-odds
+update is documented in :mod:`models.mapping.grid`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import Literal
+
+from cosim.scenario.fields import Problem, param
+
+
+@dataclass(frozen=True)
+class MappingConfig:
+    """``[mapping]``: per-robot occupancy mapping, pose correction and map sharing."""
+
+    enabled: bool = param(
+        False,
+        "robots build their own maps, localize by scan matching and plan on their own map",
+    )
+    resolution_m: float = param(0.05, "map cell size (m)", gt=0, le=1)
+    scan_matching: Literal["correlative", "none"] = param(
+        "correlative",
+        "correct odometry by correlative scan-to-map matching (Olson 2009), or none "
+        "(odometry only, for comparison)",
+    )
+    share: Literal["none", "scans", "maps"] = param(
+        "none",
+        "what robots send their neighbours over the network: nothing, their localized "
+        "scans (as slam_toolbox's multi-robot mode), or compressed map updates",
+    )
+    min_travel_m: float = param(0.5, "distance driven before a scan updates the map (m)", ge=0)
+    min_heading_rad: float = param(0.5, "or rotation before a scan updates the map (rad)", ge=0)
+    min_interval_s: float = param(0.5, "and time since the last update (s)", ge=0)
+    clear_no_return_m: float = param(
+        3.0, "a beam without a return clears free space up to this range (m)", ge=0
+    )
+    search_window_m: float = param(
+        0.3, "scan matching: half-width of the translation window (m)", gt=0, le=5
+    )
+    search_window_rad: float = param(
+        0.12, "scan matching: half-width of the rotation window (rad)", gt=0, le=1.6
+    )
+    map_update_interval_s: float = param(
+        5.0, "period of each robot's map going to its navigation and the bag (s)", gt=0
+    )
+    share_period_s: float = param(
+        2.0, "share = 'maps': period of map updates to the neighbours (s)", gt=0
+    )
+    quality_period_s: float = param(5.0, "period of tables/map_quality rows (s)", gt=0)
+
+    def problems(self) -> Iterator[Problem]:
+        """A map finer than 1 cm would be very large for a warehouse."""
+        if self.resolution_m < 0.01:
+            yield Problem("resolution_m", self.resolution_m, "a cell size >= 0.01 m")
