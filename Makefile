@@ -10,7 +10,7 @@ STUDIES := runs/studies
 STUDY = $(BIN)/cosim study studies/$(1).toml --out $(STUDIES)/$(1) --resume
 
 .PHONY: setup demo test lint bench clean help reproduce study-comm study-comm-reduced \
-	study-burst study-scale study-paper study-nav
+	study-burst study-scale study-paper study-nav study-mapping study-mapping-reduced map-aces
 
 help:  ## list the targets
 	@grep -E '^[a-z-]+:.*##' $(MAKEFILE_LIST) | sed 's/:.*## /\t/'
@@ -37,10 +37,11 @@ lint: setup  ## ruff and mypy --strict
 bench: setup  ## benchmarks -> bench/results.json
 	$(BIN)/python bench/run.py --out bench/results.json
 
-reproduce: setup  ## the paper's Scenario 1 and a reduced comm sweep (about 5 min on 2 cores)
+reproduce: setup  ## Scenario 1, a reduced comm sweep and map sharing (about 6 min on 2 cores)
 	$(call STUDY,paper)
 	$(call STUDY,comm_sweep_reduced)
-	@echo "reports: $(STUDIES)/paper/report.md $(STUDIES)/comm_sweep_reduced/report.md"
+	$(call STUDY,map_sharing_reduced)
+	@echo "reports: $(STUDIES)/paper/report.md $(STUDIES)/comm_sweep_reduced/report.md $(STUDIES)/map_sharing_reduced/report.md"
 
 study-comm: setup  ## the full comm sweep: 1,080 runs (about 30 min on 2 cores)
 	$(call STUDY,comm_sweep)
@@ -56,6 +57,16 @@ study-scale: setup  ## 4 to 200 robots: wall time, real-time factor, messages
 
 study-paper: setup  ## the paper's Scenario 1, random shelves and racks
 	$(call STUDY,paper)
+
+study-mapping: setup  ## map sharing: bandwidth x loss x share mode, 5 seeds x 300 s (about 20 min)
+	$(call STUDY,map_sharing)
+
+study-mapping-reduced: setup  ## map sharing reduced to 12 runs x 120 s
+	$(call STUDY,map_sharing_reduced)
+
+ACES ?= ../shared/data/aces_lidar
+map-aces: setup  ## map the ACES building's recording (needs ../shared/data) into runs/aces
+	$(BIN)/cosim map $(ACES) --out runs/aces --reference /ground_truth --force
 
 study-nav: setup  ## navigation acceptance: 3 presets x 10 seeds x 300 s
 	$(BIN)/python studies/nav_acceptance.py --seeds 10 --duration-s 300 --workers 2

@@ -11,6 +11,7 @@ import numpy as np
 from assignment_bench import assignment_solve_stats
 from dwa_bench import dwa_us_per_robot
 from lidar_bench import lidar_rays_per_second
+from mapping_bench import aces_mapping, fleet50_mapping, per_scan_costs
 from network_bench import network_deliveries_per_second
 from planner_bench import planner_ms
 from recording_bench import bag_cost, bag_memory_1h, encoding
@@ -336,4 +337,7 @@ SUITES: dict[str, Callable[[int], Result]] = {
     "bag_cost": bag_cost,
     "bag_memory_1h": bag_memory_1h,
     "cdr_encoding": encoding,
+    "mapping_per_scan": per_scan_costs,
+    "fleet50_mapping": fleet50_mapping,
+    "aces_mapping": aces_mapping,
 }

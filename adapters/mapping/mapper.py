@@ -48,9 +48,11 @@ from models.errors import ModelError
 from models.kinematics import FleetState
 from models.lidar import ScanGeometry
 from models.mapping.exchange import PackedUpdate, pack, unpack
-from models.mapping.grid import LogOddsMap, Scratch
+from models.mapping.grid import LogOddsMap, Scratch, merged
+from models.mapping.loops import LoopParams
 from models.mapping.matcher import MatcherParams
 from models.mapping.slam import MapperParams, ScanMapper, UpdateGate
+from models.occupancy import OccupancyGrid as Grid
 from models.world import Warehouse
 
 SCANS = "/fleet/mapping/scans"
@@ -67,22 +69,20 @@ def mapper_params(cfg: MappingConfig, lidar_min_m: float, lidar_max_m: float) ->
         range_min_m=lidar_min_m,
         range_max_m=lidar_max_m,
         clear_no_return_m=cfg.clear_no_return_m,
+        loop_closure=LoopParams() if cfg.loop_closure and cfg.scan_matching != "none" else None,
     )
 
 
 def grid_message(t_ns: int, grid: LogOddsMap) -> OccupancyGrid:
-    """A map as the nav_msgs/OccupancyGrid slam_toolbox publishes."""
-    g = grid.geometry
-    return OccupancyGrid(
-        t_ns,
-        "map",
-        g.resolution_m,
-        g.width,
-        g.height,
-        g.origin_xy_m[0],
-        g.origin_xy_m[1],
-        grid.occupancy().tobytes(),
-    )
+    """A robot's map as the nav_msgs/OccupancyGrid slam_toolbox publishes."""
+    return occupancy_message(t_ns, grid.occupancy_grid())
+
+
+def occupancy_message(t_ns: int, grid: Grid) -> OccupancyGrid:
+    """An occupancy grid as a nav_msgs/OccupancyGrid in ``map``."""
+    rows, cols = grid.data.shape
+    x0, y0 = grid.origin_xy_m
+    return OccupancyGrid(t_ns, "map", grid.resolution_m, cols, rows, x0, y0, grid.data.tobytes())
 
 
 class MappingAdapter:
@@ -107,7 +107,6 @@ class MappingAdapter:
         self.maps = [
             LogOddsMap(self.geometry, scratch=scratch, track_changes=track) for _ in self.names
         ]
-        self.fleet_map = LogOddsMap(self.geometry, scratch=scratch)
         self.params = mapper_params(self.cfg, lidar.range_min_m, lidar.range_max_m)
         self.mappers = [
             ScanMapper(grid, (float(x), float(y), float(yaw)), self.params, self.angles)
@@ -177,8 +176,7 @@ class MappingAdapter:
     def _scan(self, run: RunContext, i: int, scan: LaserScan) -> None:
         now = run.kernel.now_ns
         odom = self.odom[i]
-        # the fleet's bookkeeping map takes the scan in the same pass as the robot's map
-        update = self.mappers[i].process(now, odom, scan.ranges_m, also=self.fleet_map)
+        update = self.mappers[i].process(now, odom, scan.ranges_m)
         if update is None:
             return
         fleet = self.fleet
@@ -299,15 +297,17 @@ class MappingAdapter:
         bus = run.bus
         for grid, name, host in zip(self.maps, self.map_topics, self.hosts, strict=True):
             bus.publish(name, grid_message(now_ns, grid), host)
-        bus.publish(FLEET_MAP, grid_message(now_ns, self.fleet_map), BASE_HOST)
+        bus.publish(FLEET_MAP, occupancy_message(now_ns, merged(self.maps)), BASE_HOST)
 
     def _sample(self, now_ns: int) -> None:
-        self.records.sample(now_ns, self.maps, self.fleet_map)
+        self.records.sample(now_ns, self.maps, merged(self.maps))
 
     def finish(self, run: RunContext) -> Mapping[str, Any]:
         """Final quality, errors and sharing; the final maps for the run folder."""
-        self.records.sample(run.kernel.now_ns, self.maps, self.fleet_map)
+        fleet = merged(self.maps)
+        self.records.sample(run.kernel.now_ns, self.maps, fleet)
         for name, grid in zip(self.names, self.maps, strict=True):
             self.recorder.add_map(name, grid.occupancy_grid())
-        self.recorder.add_map("fleet", self.fleet_map.occupancy_grid())
-        return self.records.summary()
+        self.recorder.add_map("fleet", fleet)
+        closures = sum(m.loops.closures for m in self.mappers if m.loops is not None)
+        return {**self.records.summary(), "map_loop_closures": closures}

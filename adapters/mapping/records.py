@@ -6,8 +6,8 @@ Tables:
   coverage, iou, accuracy, iou_strict (:mod:`models.mapping.quality`) against the world's ground
   truth on the same grid, and ``ate_m`` / ``ate_odom_m``, the RMS position error of the
   estimate / of odometry alone over the updates so far (m; one common ``map`` frame, so
-  no alignment). The fleet's map is what a server collecting every robot's localized
-  scans would hold: bookkeeping, no robot sees it.
+  no alignment). The fleet's map is every robot's map fused (log-odds summed,
+  :func:`models.mapping.grid.merged`): bookkeeping, no robot sees it.
 - ``scan_matches``: one row per map update: the estimated pose, its error and the error
   of odometry alone against ground truth (m), the match score and whether it matched.
 - ``map_merges``: one row per scan or map update a robot added from a neighbour: its
@@ -24,8 +24,8 @@ import numpy as np
 from cosim.records import Recorder
 from cosim.timebase import NS_PER_S
 from models.mapping.grid import LogOddsMap, MapGeometry
-from models.mapping.quality import MapScores, map_scores, observable
-from models.occupancy import rasterize_boxes
+from models.mapping.quality import Int8Array, MapScores, map_scores, observable
+from models.occupancy import OccupancyGrid, rasterize_boxes
 from models.world import Warehouse
 
 QUALITY_COLUMNS = (
@@ -146,21 +146,22 @@ class MappingRecords:
         self.shared_messages += 1
         self.shared_bytes += nbytes
 
-    def sample(self, t_ns: int, maps: list[LogOddsMap], fleet: LogOddsMap) -> None:
-        """A row per robot and one for the fleet: quality now."""
+    def sample(self, t_ns: int, maps: list[LogOddsMap], fleet: OccupancyGrid) -> None:
+        """A row per robot and one for the fleet (its maps fused): quality now."""
         t_s = t_ns / NS_PER_S
         every: list[float] = []
         every_odom: list[float] = []
         for i, grid in enumerate(maps):
-            self._row(t_s, self.names[i], grid, self.errors[i], self.odom_errors[i])
+            cells = grid.occupancy()
+            self._row(t_s, self.names[i], cells, self.errors[i], self.odom_errors[i])
             every += self.errors[i]
             every_odom += self.odom_errors[i]
-        self._row(t_s, FLEET, fleet, every, every_odom)
+        self._row(t_s, FLEET, fleet.data, every, every_odom)
 
     def _row(
-        self, t_s: float, robot: str, grid: LogOddsMap, errors: list[float], odom: list[float]
+        self, t_s: float, robot: str, cells: Int8Array, errors: list[float], odom: list[float]
     ) -> None:
-        scores = map_scores(grid.occupancy(), self.truth, self.seen)
+        scores = map_scores(cells, self.truth, self.seen)
         self.last[robot] = scores
         self.quality.append(
             t_s=t_s,

@@ -53,8 +53,20 @@ class MappingConfig:
         2.0, "share = 'maps': period of map updates to the neighbours (s)", gt=0
     )
     quality_period_s: float = param(5.0, "period of tables/map_quality rows (s)", gt=0)
+    loop_closure: bool = param(
+        False,
+        "each robot closes loops: a pose graph of its map updates, re-solved when a scan "
+        "matches a place mapped long before (Karto / slam_toolbox), its map then rebuilt",
+    )
 
     def problems(self) -> Iterator[Problem]:
-        """A map finer than 1 cm would be very large for a warehouse."""
+        """A map finer than 1 cm would be very large; rebuilt maps cannot be sent as updates."""
         if self.resolution_m < 0.01:
             yield Problem("resolution_m", self.resolution_m, "a cell size >= 0.01 m")
+        if self.loop_closure and self.share == "maps":
+            yield Problem(
+                "loop_closure",
+                True,
+                "false with share = 'maps' (a map rebuilt after a loop closure would be sent "
+                "again on top of what the neighbours hold; share 'scans' instead)",
+            )

@@ -180,15 +180,13 @@ class LogOddsMap:
         range_min_m: float,
         range_max_m: float,
         clear_no_return_m: float,
-        also: LogOddsMap | None = None,
     ) -> int:
         """Add one scan taken at ``pose`` (sensor pose x, y, yaw in ``map``).
 
         Returns beyond ``range_max_m`` or infinite are "no return": their beam clears
         cells up to ``clear_no_return_m`` only (a missing echo says little about far
         space: glass, black surfaces). NaN ranges and ranges below ``range_min_m`` are
-        skipped. ``also`` (a map of the same grid) gets the same scan from the same
-        traversal of the beams.
+        skipped.
 
         Returns:
             The number of cells whose occupied state changed (at least that many when
@@ -221,8 +219,6 @@ class LogOddsMap:
             cells,
             hits,
         )
-        if also is not None:
-            also._apply(cells, hits, n)
         return self._apply(cells, hits, n)
 
     def _apply(self, cells: npt.NDArray[np.int64], hits: npt.NDArray[np.bool_], n: int) -> int:
@@ -326,3 +322,20 @@ class LogOddsMap:
         """Cells the map classifies (free or occupied)."""
         p = self.params
         return (self.logodds <= p.free) | (self.logodds >= p.occupied)
+
+
+def merged(maps: list[LogOddsMap]) -> OccupancyGrid:
+    """The maps of one grid fused cell by cell: their log-odds summed, clamped, classified.
+
+    Independent evidence adds in log-odds (the occupancy-grid fusion of several robots'
+    maps in a common frame). Maps that already hold each other's evidence (shared scans)
+    count it twice, which changes few classifications.
+    """
+    first = maps[0]
+    p = first.params
+    total = np.clip(np.sum([m.logodds for m in maps], axis=0), p.clamp_min, p.clamp_max)
+    cells = np.full(total.shape, UNKNOWN, dtype=np.int8)
+    cells[total <= p.free] = FREE
+    cells[total >= p.occupied] = OCCUPIED
+    g = first.geometry
+    return OccupancyGrid(g.resolution_m, g.origin_xy_m, cells)

@@ -66,8 +66,7 @@ class MapperParams:
         scan_matching: correct the odometry by matching (False: odometry only).
         range_min_m, range_max_m: the lidar's valid ranges (m).
         clear_no_return_m: how far a beam without a return clears (m).
-        loop_closure: close loops (:mod:`models.mapping.loops`), or None. A closure
-            rebuilds the robot's map, so not with a map kept beside it (``also``).
+        loop_closure: close loops (:mod:`models.mapping.loops`), or None.
     """
 
     gate: UpdateGate = field(default_factory=UpdateGate)
@@ -148,20 +147,14 @@ class ScanMapper:
         t_ns: int,
         odom: Pose,
         ranges_m: npt.NDArray[np.floating[Any]],
-        *,
-        also: LogOddsMap | None = None,
     ) -> Update | None:
-        """Take one scan with the odometry pose it was taken at; an :class:`Update` if it mapped.
-
-        ``also``: another map of the same grid that takes the scan at the same pose (the
-        fleet's bookkeeping map), in the same pass.
-        """
+        """Take one scan with the odometry pose it was taken at; an :class:`Update` if it mapped."""
         p = self.params
         if self._odom_ref is None:
             # the first scan anchors odometry to the known start pose
             self._odom_ref = odom
             self.correction = compose(self.start, inverse(odom))
-            return self._add(t_ns, odom, self.start, self.start, 0.0, False, ranges_m, also)
+            return self._add(t_ns, odom, self.start, self.start, 0.0, False, ranges_m)
         motion = relative(self._odom_ref, odom)
         if not p.gate.due(motion, (t_ns - self._last_ns) / 1e9):
             return None
@@ -177,7 +170,7 @@ class ScanMapper:
             )
             result = match(self.grid, prior, points, p.matcher)
             pose, score, matched = result.pose, result.score, result.matched
-        return self._add(t_ns, odom, pose, prior, score, matched, ranges_m, also)
+        return self._add(t_ns, odom, pose, prior, score, matched, ranges_m)
 
     def _add(
         self,
@@ -188,7 +181,6 @@ class ScanMapper:
         score: float,
         matched: bool,
         ranges_m: npt.NDArray[np.floating[Any]],
-        also: LogOddsMap | None,
     ) -> Update:
         p = self.params
         flipped = self.grid.integrate(
@@ -198,11 +190,8 @@ class ScanMapper:
             range_min_m=p.range_min_m,
             range_max_m=p.range_max_m,
             clear_no_return_m=p.clear_no_return_m,
-            also=also,
         )
         if self.loops is not None:
-            if also is not None:
-                raise ValueError("loop closure rebuilds the map: no map beside it (also)")
             self.loops.add(pose, odom, np.asarray(ranges_m, dtype=np.float32), matched)
             closed = self.loops.close(self.grid)
             if closed is not None:

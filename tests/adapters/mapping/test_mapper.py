@@ -96,3 +96,16 @@ def test_the_same_seed_gives_the_same_maps_and_tables(tmp_path):
         assert second.deterministic_tables()[name].equals(frame), name
     for name in first.maps:
         assert np.array_equal(first.maps[name].data, second.maps[name].data)
+
+
+def test_robots_can_close_loops_in_a_run(tmp_path):
+    closed = _run(tmp_path, **{"mapping.loop_closure": True, "scenario.duration_s": 60.0})
+    assert closed.summary["map_loop_closures"] > 0
+    assert closed.summary["map_ate_m"] <= closed.summary["map_ate_odom_m"] / 3
+
+
+def test_loop_closure_with_shared_map_updates_is_refused_naming_the_keys():
+    with pytest.raises(cosim.ConfigError, match=r"\[mapping\] loop_closure = true: expected false"):
+        cosim.load_scenario(
+            "warehouse-mapping", overrides={"mapping.loop_closure": True, "mapping.share": "maps"}
+        )

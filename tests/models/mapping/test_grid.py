@@ -72,21 +72,6 @@ def test_a_robot_that_sees_nothing_does_not_corrupt_a_map_it_built():
     assert np.array_equal(grid.occupancy(), before)
 
 
-def test_the_other_map_given_takes_the_same_scan():
-    lidar = Lidar(ROOM)
-    one, other = room_map(), room_map()
-    ranges = lidar.scan(POSE)
-    one.integrate(
-        POSE, lidar.angles, ranges, range_min_m=0.1, range_max_m=10.0, clear_no_return_m=3.0,
-        also=other,
-    )  # fmt: skip
-    alone = room_map()
-    integrate(alone, lidar, POSE)
-    assert np.array_equal(one.logodds, alone.logodds)
-    assert np.array_equal(other.logodds, alone.logodds)
-    assert np.array_equal(other.score, alone.score)
-
-
 def test_trinary_cells_follow_the_thresholds():
     grid = room_map()
     p = grid.params

@@ -87,6 +87,6 @@ def test_branch_and_bound_finds_the_exhaustive_search_optimum(dx, dy, dyaw, seed
     g = grid.geometry
     *_, score, _ = _search(
         grid.score, grid.coarse, g.origin_xy_m[0], g.origin_xy_m[1], g.resolution_m,
-        points[:, 0].copy(), points[:, 1].copy(), *prior, offsets, n_lin, COARSE, 0.1,
+        points[:, 0].copy(), points[:, 1].copy(), *prior, offsets, n_lin, COARSE, 0.1, 0.0,
     )  # fmt: skip
     assert score == pytest.approx(_brute_force(grid, prior, points, offsets, n_lin, 0.1))
