@@ -300,6 +300,13 @@ def build_parser() -> argparse.ArgumentParser:
         help="correct odometry by scan matching, or none (odometry only, for comparison)",
     )
     mapping.add_argument(
+        "--match-margin",
+        type=_non_negative_float,
+        default=0.0,
+        help="score (0..1) by which a matched pose must beat the odometry's prediction "
+        "(default 0: corrections of noisy real odometry matter; runs use 0.02)",
+    )
+    mapping.add_argument(
         "--no-loop-closure",
         action="store_true",
         help="do not close loops (scan-to-map matching only, as the robots in a run do)",
@@ -508,6 +515,7 @@ def _cmd_bag(args: argparse.Namespace) -> int:
 
 def _cmd_map(args: argparse.Namespace) -> int:
     from cosim.bagmap import map_bag
+    from models.mapping.matcher import MatcherParams
     from models.mapping.slam import UpdateGate
 
     progress = None if args.quiet else ProgressLine(label=f"{args.bag.name}: ")
@@ -520,6 +528,7 @@ def _cmd_map(args: argparse.Namespace) -> int:
             reference_topic=args.reference,
             resolution_m=args.resolution_m,
             gate=UpdateGate(min_travel_m=args.min_travel_m),
+            matcher=MatcherParams(margin=args.match_margin),
             scan_matching=args.scan_matching != "none",
             loop_closure=not args.no_loop_closure,
             force=args.force,

@@ -28,6 +28,7 @@ import numpy as np
 from adapters.mapping.geometry import map_geometry
 from adapters.mapping.records import MappingRecords
 from adapters.naming import topic
+from adapters.navigation.stack import ROBOT_STATES
 from cosim.adapter import RunContext
 from cosim.bus import Envelope, TopicQos
 from cosim.hosts import BASE_HOST, HostId
@@ -39,11 +40,13 @@ from cosim.messages import (
     Message,
     OccupancyGrid,
     Odometry,
+    RobotState,
     TFMessage,
     Transform,
 )
 from cosim.scenario.mapping import MappingConfig
-from cosim.timebase import period_ns
+from cosim.timebase import period_ns, s_to_ns
+from models.arrays import FloatArray
 from models.errors import ModelError
 from models.kinematics import FleetState
 from models.lidar import ScanGeometry
@@ -58,13 +61,19 @@ from models.world import Warehouse
 SCANS = "/fleet/mapping/scans"
 UPDATES = "/fleet/mapping/updates"
 FLEET_MAP = "/fleet/map"
+ROBOT_MARGIN_M = 0.15
+"""Returns this close to a robot's disc are taken as the robot's (m): pose age and noise."""
 
 
 def mapper_params(cfg: MappingConfig, lidar_min_m: float, lidar_max_m: float) -> MapperParams:
     """The model parameters of ``[mapping]`` for a lidar's valid ranges."""
     return MapperParams(
         gate=UpdateGate(cfg.min_travel_m, cfg.min_heading_rad, cfg.min_interval_s),
-        matcher=MatcherParams(window_m=cfg.search_window_m, window_rad=cfg.search_window_rad),
+        matcher=MatcherParams(
+            window_m=cfg.search_window_m,
+            window_rad=cfg.search_window_rad,
+            margin=cfg.match_margin,
+        ),
         scan_matching=cfg.scan_matching != "none",
         range_min_m=lidar_min_m,
         range_max_m=lidar_max_m,
@@ -127,6 +136,15 @@ class MappingAdapter:
         elif self.cfg.share == "maps":
             bus.advertise(UPDATES, MapUpdate)
         self.recorder = run.recorder
+        nav = run.scenario.navigation
+        # with a robots layer each robot hears where the others are: returns off them are
+        # left out of its map and its matching (robots are not the building)
+        self.robots_layer = nav.robots_layer and run.scenario.robots.driver in (
+            "navigation",
+            "tasks",
+        )
+        self.others: list[dict[str, tuple[float, float, float, int]]] = [{} for _ in self.names]
+        self.others_timeout_ns = s_to_ns(nav.robots_layer_timeout_s)
 
     # -- wiring ----------------------------------------------------------------------
     def start(self, run: RunContext) -> None:
@@ -135,6 +153,8 @@ class MappingAdapter:
         for i, (name, host) in enumerate(zip(self.names, self.hosts, strict=True)):
             bus.subscribe(topic(name, "odom"), host, self._on_odom(i))
             bus.subscribe(topic(name, "scan"), host, self._on_scan(run, i))
+            if self.robots_layer:
+                bus.subscribe(ROBOT_STATES, host, self._on_robot_state(i))
             if self.cfg.share == "scans":
                 bus.subscribe(SCANS, host, self._on_shared_scan(run, i))
             elif self.cfg.share == "maps":
@@ -172,11 +192,52 @@ class MappingAdapter:
 
         return on_scan
 
+    def _on_robot_state(self, i: int) -> Callable[[Message, Envelope], None]:
+        me = self.names[i]
+        known = self.others[i]
+
+        def on_state(message: Message, envelope: Envelope) -> None:
+            assert isinstance(message, RobotState)
+            if message.robot != me:
+                known[message.robot] = (
+                    message.x_m,
+                    message.y_m,
+                    message.radius_m,
+                    envelope.t_recv_ns,
+                )
+
+        return on_state
+
+    def _without_robots(self, i: int, now_ns: int, ranges: FloatArray) -> FloatArray:
+        """The scan with returns off robots it heard of (recently) set to NaN (ignored)."""
+        discs = np.array(
+            [
+                (x, y, r)
+                for x, y, r, t in self.others[i].values()
+                if now_ns - t <= self.others_timeout_ns
+            ]
+        ).reshape(-1, 3)
+        if not len(discs):
+            return ranges
+        x, y, yaw = self.mappers[i].estimate(self.odom[i])
+        ends = np.stack(
+            [x + ranges * np.cos(yaw + self.angles), y + ranges * np.sin(yaw + self.angles)], axis=1
+        )
+        gap = np.hypot(*(ends[:, None, :] - discs[None, :, :2]).transpose(2, 0, 1))
+        on_robot = (gap <= discs[None, :, 2] + ROBOT_MARGIN_M).any(axis=1)
+        return np.where(on_robot, np.nan, ranges)
+
     # -- a robot's own scans ---------------------------------------------------------------
     def _scan(self, run: RunContext, i: int, scan: LaserScan) -> None:
         now = run.kernel.now_ns
         odom = self.odom[i]
-        update = self.mappers[i].process(now, odom, scan.ranges_m)
+        mapper = self.mappers[i]
+        if not mapper.due(now, odom):
+            return
+        ranges = scan.ranges_m
+        if self.robots_layer:
+            ranges = self._without_robots(i, now, ranges.astype(np.float64)).astype(np.float32)
+        update = mapper.process(now, odom, ranges)
         if update is None:
             return
         fleet = self.fleet

@@ -9,6 +9,7 @@ from pathlib import Path
 from cosim.errors import ExportError
 from cosim.plotting.animation import animation_gif
 from cosim.plotting.assignment import assignment_figure
+from cosim.plotting.maps import has_maps, maps_figure, quality_figure
 from cosim.plotting.network import inter_host, network_figure
 from cosim.plotting.rundata import RunData, load_run
 from cosim.plotting.timeline import timeline_figure
@@ -37,6 +38,8 @@ def plot_run(
     - ``tasks.png``: the task timeline, if the run has tasks;
     - ``network.png``: messages and latency over time, if messages crossed hosts;
     - ``assignment.png``: convergence per epoch, if the run has assignment rounds;
+    - ``maps.png`` and ``map_quality.png``: the robots' maps and their quality over time,
+      if the robots mapped;
     - ``run.gif`` with ``gif``: an animation of the run.
 
     Figures whose data the run lacks are skipped, not drawn empty.
@@ -70,6 +73,10 @@ def plot_run(
         written.append(network_figure(run, folder / "network.png"))
     if run.assignments is not None:
         written.append(assignment_figure(run, folder / "assignment.png"))
+    if has_maps(run):
+        written.append(maps_figure(run, folder / "maps.png"))
+        quality = quality_figure(run, folder / "map_quality.png")
+        written += [quality] if quality is not None else []
     if gif:
         written.append(animation_gif(run, folder / "run.gif"))
     return written

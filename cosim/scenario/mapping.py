@@ -46,6 +46,14 @@ class MappingConfig:
     search_window_rad: float = param(
         0.12, "scan matching: half-width of the rotation window (rad)", gt=0, le=1.6
     )
+    match_margin: float = param(
+        0.02,
+        "scan matching: how much better than the odometry's prediction (score 0..1) a pose "
+        "must fit to replace it; on the simulated warehouse 0.02 gave fleet map IoU 0.86-0.95 "
+        "over 10 seeds where 0 gave 0.82-0.90 (cosim map uses 0: real odometry is noisier)",
+        ge=0,
+        le=1,
+    )
     map_update_interval_s: float = param(
         5.0, "period of each robot's map going to its navigation and the bag (s)", gt=0
     )

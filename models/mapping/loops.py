@@ -36,7 +36,8 @@ class LoopParams:
         min_path_m: and only if the robot travelled at least this since them (m).
         local_nodes: nodes on each side of the nearest candidate that make the local map.
         every_nodes: search at most every this many nodes.
-        matcher: the wide window of the loop match, and the score it needs.
+        matcher: the wide window of the loop match, and the score it needs; no margin
+            (keeping the prior would assert the drifted estimate as a closure).
         sequential_sigma: (m, rad) trust in consecutive scan matches.
         loop_sigma: (m, rad) trust in a loop closure.
         rebuild_shift_m: rebuild the map when optimisation moves a node more than this (m).
@@ -48,7 +49,7 @@ class LoopParams:
     every_nodes: int = 3
     matcher: MatcherParams = field(
         default_factory=lambda: MatcherParams(
-            window_m=1.5, window_rad=0.3, max_points=180, min_score=0.55
+            window_m=1.5, window_rad=0.3, max_points=180, min_score=0.55, margin=0.0
         )
     )
     sequential_sigma: tuple[float, float] = (0.05, 0.02)

@@ -142,6 +142,12 @@ class ScanMapper:
         """
         return compose(self.correction, odom)
 
+    def due(self, t_ns: int, odom: Pose) -> bool:
+        """Whether a scan at ``t_ns`` taken at odometry pose ``odom`` would update the map."""
+        if self._odom_ref is None:
+            return True
+        return self.params.gate.due(relative(self._odom_ref, odom), (t_ns - self._last_ns) / 1e9)
+
     def process(
         self,
         t_ns: int,

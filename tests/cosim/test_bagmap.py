@@ -111,3 +111,20 @@ def test_a_folder_that_is_not_a_bag_or_a_full_output_folder_is_refused(drifting_
     (out / "notes.txt").write_text("mine")
     with pytest.raises(ExportError, match="not empty"):
         map_bag(drifting_bag, out, scan_topic="/robot_1/scan", odom_topic="/robot_1/odom")
+
+
+def test_a_sqlite3_bag_maps_through_the_same_path(tmp_path):
+    overrides = {
+        **SMALL,
+        "robots.driver": "navigation",
+        "lidar.beams": 180,
+        "scenario.duration_s": 10.0,
+        "record.bag": "sqlite3",
+        "record.topics": ["/robot_2/scan", "/robot_2/odom"],
+    }
+    cosim.run(cosim.load_scenario("warehouse-random", overrides=overrides), out=tmp_path / "run")
+    result = map_bag(
+        tmp_path / "run" / "bag", tmp_path / "map", scan_topic="/robot_2/scan",
+        odom_topic="/robot_2/odom",
+    )  # fmt: skip
+    assert result.summary["scans"] == 100 and result.summary["map_updates"] >= 1

@@ -109,3 +109,28 @@ def test_loop_closure_with_shared_map_updates_is_refused_naming_the_keys():
         cosim.load_scenario(
             "warehouse-mapping", overrides={"mapping.loop_closure": True, "mapping.share": "maps"}
         )
+
+
+def test_with_a_robots_layer_the_other_robots_stay_out_of_the_maps():
+    from cosim.worldfiles import scenario_warehouse
+    from models.mapping.quality import dilate
+    from models.occupancy import rasterize_boxes
+
+    phantoms = {}
+    for layer in (False, True):
+        overrides = {
+            **MAPPING,
+            "robots.count": 6,
+            "navigation.robots_layer": layer,
+            "scenario.duration_s": 30.0,
+        }
+        scenario = cosim.load_scenario("warehouse-random", overrides=overrides)
+        fleet = cosim.run(scenario).maps["fleet"]
+        (x0, y0), r = fleet.origin_xy_m, fleet.resolution_m
+        rows, cols = fleet.data.shape
+        truth = rasterize_boxes(
+            scenario_warehouse(scenario).boxes, (x0, y0, x0 + cols * r, y0 + rows * r), r
+        ).data
+        # mapped obstacles more than two cells from any real one: robots mapped as walls
+        phantoms[layer] = int(((fleet.data == 100) & ~dilate(dilate(truth == 100))).sum())
+    assert phantoms[False] > 20 and phantoms[True] == 0
