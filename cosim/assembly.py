@@ -43,11 +43,20 @@ def adapter_names(scenario: Scenario, *, recording: bool = False) -> list[str]:
         names.append("lidar")
     if scenario.mapping.enabled:
         names.append("mapping")
+    if scenario.mocap.source != "none":
+        names.append("mocap")
+    if scenario.physical.robots:
+        names.append("physical")
     names += DRIVERS[driver] + ["poses"]
     if recording:
         names.append("ros_interface")
     names += [name for name in scenario.scenario.adapters if name not in names]
     return names
+
+
+def needs_realtime(scenario: Scenario) -> bool:
+    """Whether the scenario talks to the real world (physical robots, live mocap)."""
+    return bool(scenario.physical.robots) or scenario.mocap.source in ("motioncapture", "ros2")
 
 
 @dataclass
@@ -73,7 +82,8 @@ def assemble(
         scenario: the validated scenario.
         names: adapters to run instead of :func:`adapter_names` (requirements are added).
         registry: the adapter registry; defaults to the installed entry points.
-        realtime: pace the kernel against the wall clock.
+        realtime: pace the kernel against the wall clock (forced, at speed 1, for
+            scenarios that talk to the real world: :func:`needs_realtime`).
         speed: simulated seconds per wall-clock second when ``realtime``.
         recording: the run is recorded or viewed live (see :func:`adapter_names`).
     """
@@ -81,6 +91,8 @@ def assemble(
     if names is None:
         names = adapter_names(scenario, recording=recording)
     ordered = registry.resolve(names)
+    if needs_realtime(scenario):
+        realtime, speed = True, 1.0
     kernel = Kernel(realtime=realtime, speed=speed)
     recorder = Recorder(record_messages=scenario.record.messages)
     bus = Bus(kernel, tap=recorder)

@@ -63,6 +63,7 @@ def _describe(scenario: Scenario) -> str:
 def _cmd_run(args: argparse.Namespace) -> int:
     from cosim.recording.live import LiveOptions
     from cosim.runner import run
+    from cosim.standins import Standins
 
     if args.bag is not None:
         args.overrides.append(f"record.bag={args.bag}")
@@ -76,7 +77,12 @@ def _cmd_run(args: argparse.Namespace) -> int:
         else None
     )
     progress = None if args.quiet else ProgressLine(label=f"{scenario.name}: ")
+    standins = Standins(scenario) if args.standin else None
     try:
+        if standins is not None:
+            started = standins.start()
+            if not args.quiet:
+                print(f"stand-in robots: {', '.join(started)}", flush=True)
         result = run(
             scenario,
             duration_s=args.duration_s,
@@ -89,6 +95,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
     finally:
         if progress is not None:
             progress.close()
+        if standins is not None:
+            standins.stop()
     figures = []
     if args.figures or args.gif:
         from cosim.plotting.command import plot_run
@@ -268,6 +276,12 @@ def _cmd_scenarios(_args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _cmd_standin(args: argparse.Namespace) -> int:
+    from cosim.standin import serve
+
+    return serve(args)
+
+
 COMMANDS = {
     "run": _cmd_run,
     "check": _cmd_check,
@@ -277,6 +291,7 @@ COMMANDS = {
     "map": _cmd_map,
     "plot": _cmd_plot,
     "scenarios": _cmd_scenarios,
+    "standin": _cmd_standin,
 }
 
 

@@ -10,6 +10,8 @@ import argparse
 from pathlib import Path
 from typing import NoReturn
 
+from cosim.standin import add_arguments as add_standin_arguments
+
 EXIT_INPUT = 2
 
 
@@ -120,6 +122,12 @@ def build_parser() -> argparse.ArgumentParser:
         ),
     )
     _scenario_argument(run)
+    run.add_argument(
+        "--standin",
+        action="store_true",
+        help="start a stand-in robot process (cosim standin) for every physical robot of "
+        "the scenario, so mixed-reality scenarios run without hardware",
+    )
     run.add_argument("--out", type=Path, help="results folder (default: runs/NAME-seedN)")
     run.add_argument("--seed", type=_non_negative_int, help="override scenario.seed")
     run.add_argument("--duration-s", type=_positive_float, help="override scenario.duration_s (s)")
@@ -304,6 +312,19 @@ def build_parser() -> argparse.ArgumentParser:
     )
     plot.add_argument("--gif", action="store_true", help="also write an animation run.gif")
     plot.add_argument("--out", type=Path, help="folder for the figures (default RUN_DIR/figures)")
+
+    standin = commands.add_parser(
+        "standin",
+        help="run a stand-in physical robot speaking ROS 2 over DDS",
+        description=(
+            "Play a physical robot without hardware: a separate process on the DDS domain "
+            "that integrates /NAME/cmd_vel (geometry_msgs/Twist) within the robot's limits and "
+            "publishes its pose on /NAME/pose (geometry_msgs/PoseStamped, as a motion-capture "
+            "bridge would, with latency and noise) and its odometry on /NAME/odom. Runs "
+            "until Ctrl-C or --duration-s; DDS stays on loopback unless --interface is given."
+        ),
+    )
+    add_standin_arguments(standin)
 
     commands.add_parser(
         "scenarios",

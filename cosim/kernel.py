@@ -16,8 +16,9 @@ three things to a plain :class:`simpy.Environment`:
 from __future__ import annotations
 
 import time
+from array import array
 from collections.abc import Callable, Generator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from enum import IntEnum
 from typing import Any
 
@@ -65,6 +66,26 @@ class Periodic:
         self.active = False
 
 
+@dataclass
+class Lateness:
+    """How far a real-time run fell behind the wall clock, one entry per event batch.
+
+    A batch is the events due at one simulated instant. Its lateness is measured when its
+    first event is due to run: the wall-clock time past the instant the batch should have
+    started (0 when the kernel was early and slept). Nothing is absorbed: a late batch is
+    recorded late, and the run goes on from there (SimPy's non-strict real-time mode).
+
+    Attributes:
+        t_ns: the batches' simulated instants (ns).
+        late_ns: their lateness in wall-clock ns (>= 0).
+        events: events processed in each batch.
+    """
+
+    t_ns: array[int] = field(default_factory=lambda: array("q"))
+    late_ns: array[int] = field(default_factory=lambda: array("q"))
+    events: array[int] = field(default_factory=lambda: array("q"))
+
+
 ProgressFn = Callable[[int, int], None]
 """Called during :meth:`Kernel.run` with (sim time in ns, events processed so far)."""
 
@@ -89,6 +110,27 @@ class Kernel:
         else:
             self.env = simpy.Environment(initial_time=0)
         self.events_processed = 0
+        self.speed = speed
+        self.lateness: Lateness | None = Lateness() if realtime else None
+        """Per-batch lateness of a real-time run (None when not real time)."""
+        self._wall_epoch_ns = time.time_ns()
+
+    @property
+    def realtime(self) -> bool:
+        """Whether the kernel is paced against the wall clock."""
+        return self.lateness is not None
+
+    def wall_ns(self, t_ns: int) -> int:
+        """The wall-clock time (ns since the Unix epoch) of simulated instant ``t_ns``.
+
+        Only meaningful in real time (before the run starts it is the construction time);
+        used to stamp what goes to real systems, which keep ROS time.
+        """
+        return self._wall_epoch_ns + round(t_ns / self.speed)
+
+    def sim_ns(self, wall_ns: int) -> int:
+        """The simulated instant of wall-clock time ``wall_ns`` (ns since the Unix epoch)."""
+        return round((wall_ns - self._wall_epoch_ns) * self.speed)
 
     @property
     def now_ns(self) -> int:
@@ -169,8 +211,12 @@ class Kernel:
             progress_interval_s: wall-clock seconds between progress calls.
         """
         env = self.env
-        if isinstance(env, simpy.rt.RealtimeEnvironment) and self.events_processed == 0:
-            env.sync()  # the wall clock starts with the run, not when the kernel was built
+        if isinstance(env, simpy.rt.RealtimeEnvironment):
+            if self.events_processed == 0:
+                # the wall clock starts with the run, not when the kernel was built
+                env.sync()
+                self._wall_epoch_ns = time.time_ns() - round(self.now_ns / self.speed)
+            return self._run_realtime(env, until_ns, progress, progress_interval_s)
         step = env.step
         peek = env.peek
         processed = 0
@@ -183,6 +229,47 @@ class Kernel:
                 if wall >= next_report:
                     progress(self.now_ns, processed)
                     next_report = wall + progress_interval_s
+        if until_ns > self.now_ns:
+            env.run(until=until_ns)
+        self.events_processed += processed
+        if progress is not None:
+            progress(self.now_ns, processed)
+        return processed
+
+    def _run_realtime(
+        self,
+        env: simpy.rt.RealtimeEnvironment,
+        until_ns: int,
+        progress: ProgressFn | None,
+        progress_interval_s: float,
+    ) -> int:
+        """The run loop of a real-time kernel: paced, and lateness measured per batch."""
+        assert self.lateness is not None
+        record = self.lateness
+        peek = env.peek
+        step = env.step
+        monotonic = time.monotonic
+        factor = env.factor
+        processed = 0
+        batch_t = -1
+        batch_events = 0
+        next_report = monotonic() + progress_interval_s
+        while (t := peek()) < until_ns:
+            if t != batch_t:
+                if batch_t >= 0:
+                    record.events.append(batch_events)
+                due = env.real_start + (t - env.env_start) * factor
+                record.t_ns.append(int(t))
+                record.late_ns.append(max(0, round((monotonic() - due) * 1e9)))
+                batch_t, batch_events = int(t), 0
+            step()
+            processed += 1
+            batch_events += 1
+            if progress is not None and monotonic() >= next_report:
+                progress(self.now_ns, processed)
+                next_report = monotonic() + progress_interval_s
+        if batch_t >= 0:
+            record.events.append(batch_events)
         if until_ns > self.now_ns:
             env.run(until=until_ns)
         self.events_processed += processed

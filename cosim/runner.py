@@ -12,13 +12,15 @@ from importlib.metadata import version
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
 from cosim.assembly import Assembly, assemble
 from cosim.errors import ExportError
+from cosim.kernel import Lateness
 from cosim.recording.live import LiveOptions
 from cosim.recording.session import RecordingPlan, RecordingSession
-from cosim.records import MapArtifact, merge_counts
+from cosim.records import MapArtifact, Recorder, merge_counts
 from cosim.registry import AdapterRegistry
 from cosim.scenario.loader import dump_scenario
 from cosim.scenario.model import Scenario
@@ -140,7 +142,13 @@ def _run_assembled(
         if progress is not None:
             progress(now_ns / NS_PER_S, duration_s, time.perf_counter() - wall_start)
 
-    events = run.kernel.run(until_ns, progress=report if progress else None)
+    try:
+        events = run.kernel.run(until_ns, progress=report if progress else None)
+    finally:
+        for _name, adapter in assembly.adapters:
+            close = getattr(adapter, "close", None)
+            if close is not None:
+                close()
     wall_s = time.perf_counter() - wall_start
     counts = run.recorder.counts
     sent = sum(counts.values())
@@ -160,6 +168,8 @@ def _run_assembled(
         "network_messages": run.recorder.network_messages,
         "network_bytes": run.recorder.network_bytes,
     }
+    if run.kernel.lateness is not None:
+        summary.update(record_lateness(run.kernel.lateness, run.recorder))
     for name, adapter in assembly.adapters:
         try:
             merge_counts(summary, adapter.finish(run))
@@ -172,6 +182,28 @@ def _run_assembled(
         volatile=run.recorder.volatile,
         maps=dict(run.recorder.maps),
     )
+
+
+def record_lateness(lateness: Lateness, recorder: Recorder) -> dict[str, Any]:
+    """Write ``tables/realtime`` (one row per event batch) and return the summary keys.
+
+    Columns: t_s (the batch's simulated instant), lateness_ms (wall-clock ms past the
+    instant it was due), events (in the batch). Wall-clock figures: volatile.
+    """
+    late_ms = np.frombuffer(lateness.late_ns, dtype=np.int64) / 1e6
+    table = recorder.table("realtime", ("t_s", "lateness_ms", "events"), volatile=("lateness_ms",))
+    table.extend(
+        t_s=np.frombuffer(lateness.t_ns, dtype=np.int64) / NS_PER_S,
+        lateness_ms=late_ms,
+        events=np.frombuffer(lateness.events, dtype=np.int64),
+    )
+    if late_ms.size == 0:
+        return {"max_lateness_ms": None, "p99_lateness_ms": None, "late_batches": 0}
+    return {
+        "max_lateness_ms": round(float(late_ms.max()), 3),
+        "p99_lateness_ms": round(float(np.percentile(late_ms, 99)), 3),
+        "late_batches": int((late_ms > 1.0).sum()),
+    }
 
 
 def prepare_out(out: Path, *, force: bool) -> None:

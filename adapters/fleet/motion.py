@@ -16,6 +16,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from adapters.fleet.mirror import Mirrors
 from adapters.naming import robot_name, topic
 from cosim.adapter import RunContext
 from cosim.bus import Envelope
@@ -64,7 +65,9 @@ class FleetAdapter:
         self.odom = world.starts.astype(float).copy()
         self._noise = BlockDraws([run.rng.stream(f"odometry/{n}") for n in names], width=2)
         self._frames = [(f"{n}/odom", f"{n}/base_link") for n in names]
+        self.mirrors = Mirrors(self.state)
         run.provide(self.state)
+        run.provide(self.mirrors)
         run.provide(self)
         for name in names:
             run.bus.advertise(topic(name, "odom"), Odometry)
@@ -96,6 +99,8 @@ class FleetAdapter:
             motion = state.propose(self.limits, self.dt_s)
             for guard in self.guards:
                 guard(now_ns, motion)
+            if self.mirrors.any:
+                self.mirrors.apply(motion, self.dt_s)
             state.commit(motion)
             # the arc each robot drove: guards zero the velocity of robots they hold
             self._integrate_odometry(motion.v * self.dt_s, motion.w * self.dt_s)

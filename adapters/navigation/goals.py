@@ -3,7 +3,9 @@
 Until tasks exist, each robot gets a stream of goals: a free cell of the inflated static
 map, drawn from the robot's own random stream, in the same connected free region as the
 robot; a new one when the previous is reached, found unreachable, or reported stuck (as a
-fleet manager would re-target a stalled robot).
+fleet manager would re-target a stalled robot). With ``navigation.goals`` the goals are
+that series instead, in order and round again (robot ``i`` starts at goal ``i``), as the
+paper's Scenario 2 sends its robot through a series of goal poses.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ from scipy import ndimage
 from adapters.naming import topic
 from cosim.adapter import RunContext
 from cosim.bus import Envelope
+from cosim.errors import ConfigError
 from cosim.hosts import HostId
 from cosim.messages import Message, NavGoal, NavStatus
 from models.kinematics import FleetState
@@ -46,6 +49,13 @@ class GoalsAdapter:
             ix, iy = static.world_to_cell((x, y))
             region = labels == labels[iy, ix] if labels[iy, ix] else np.zeros_like(free)
             self.cells.append(np.argwhere(free & region))  # (k, 2) as (iy, ix)
+        width, height = run.scenario.world.size_m
+        for x, y in run.scenario.navigation.goals:
+            if not (0 <= x <= width and 0 <= y <= height):
+                raise ConfigError(
+                    f"{run.scenario.source}: [navigation] goals has [{x:g}, {y:g}]: expected "
+                    f"points inside the room [0, {width:g}] x [0, {height:g}] m"
+                )
         self.rngs = [run.rng.stream(f"goals/{n}") for n in self.names]
         self.next_id = np.zeros(len(self.names), dtype=np.int64)
         self.sent = 0
@@ -69,12 +79,20 @@ class GoalsAdapter:
         return on_status
 
     def _send(self, run: RunContext, i: int) -> None:
+        series = run.scenario.navigation.goals
+        if series:
+            x, y = series[(i + int(self.next_id[i])) % len(series)]
+            self._publish(run, i, x, y)
+            return
         cells = self.cells[i]
         if not len(cells):
             return
         iy, ix = cells[int(self.rngs[i].integers(len(cells)))]
         x, y = self.static.cell_to_world((int(ix), int(iy)))
-        goal = NavGoal(run.kernel.now_ns, int(self.next_id[i]), float(x), float(y))
+        self._publish(run, i, float(x), float(y))
+
+    def _publish(self, run: RunContext, i: int, x: float, y: float) -> None:
+        goal = NavGoal(run.kernel.now_ns, int(self.next_id[i]), x, y)
         self.next_id[i] += 1
         self.sent += 1
         run.bus.publish(topic(self.names[i], "nav/goal"), goal, self.hosts[i])

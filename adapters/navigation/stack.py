@@ -29,6 +29,7 @@ from adapters.fleet.motion import drive_limits
 from adapters.mapping.geometry import map_geometry, unknown_grid
 from adapters.naming import topic
 from adapters.navigation.layers import StaticLayers
+from adapters.navigation.localization import MeasuredPoses
 from adapters.navigation.records import NavRecords
 from adapters.navigation.recovery import Recovery
 from adapters.navigation.scan_memory import MovingMemory, ScanMemory
@@ -122,6 +123,8 @@ class NavigationAdapter:
             )
         else:
             self.layers = StaticLayers.shared(self.static, len(self.names))
+        self.measured = MeasuredPoses(run, self.names)
+        """Robots localizing by motion capture (or their own reported pose)."""
         self.correction = [(0.0, 0.0, 0.0)] * len(self.names)
         """Per robot ``map -> odom`` from its mapping (identity without mapping)."""
         self.limits = drive_limits(run)
@@ -173,6 +176,7 @@ class NavigationAdapter:
             if self.mapping:
                 bus.subscribe(topic(name, "tf"), host, self._on_correction(i))
                 bus.subscribe(topic(name, "map"), host, self._on_map(i))
+        self.measured.subscribe(run, self.hosts, self._on_measured_pose)
         kernel = run.kernel
         kernel.every(self.period_ns, lambda now: self._control(run, now), stage=Stage.CONTROL)
         kernel.every(
@@ -189,13 +193,20 @@ class NavigationAdapter:
                 stage=Stage.CONTROL,
             )
 
+    def _on_measured_pose(self, i: int, x_m: float, y_m: float, yaw_rad: float) -> None:
+        self.pose[i] = (x_m, y_m, yaw_rad)
+
     def _on_odom(self, i: int) -> Callable[[Message, Envelope], None]:
+        tracked = self.measured.tracked
+
         def on_odom(message: Message, _envelope: Envelope) -> None:
             assert isinstance(message, Odometry)
+            self.vel[i] = (message.v_mps, message.w_radps)
+            if tracked[i]:
+                return  # localized by measured poses
             odom = (message.x_m, message.y_m, message.yaw_rad)
             # localized: the mapping's map -> odom correction applied to odometry
             self.pose[i] = compose(self.correction[i], odom) if self.mapping else odom
-            self.vel[i] = (message.v_mps, message.w_radps)
 
         return on_odom
 
@@ -418,8 +429,10 @@ class NavigationAdapter:
             moving, len(self.names), self.radius, self.limits.max_speed_mps, self.traffic
         )
         v = np.minimum(result.v, caps)
-        v = np.where(self.active, v, 0.0)
-        w = np.where(self.active, result.w, 0.0)
+        # a robot without a recent pose does not know where it is: it stops
+        moving_ok = self.active & ~self.measured.check(now_ns)
+        v = np.where(moving_ok, v, 0.0)
+        w = np.where(moving_ok, result.w, 0.0)
         self._track_progress(run, now_ns, remaining)
         # halted: the controller found nothing admissible ahead, or chose to stand still
         # (a robot in the way) while its goal is elsewhere
@@ -427,7 +440,7 @@ class NavigationAdapter:
         self.recovery.apply(
             now_ns,
             halted,
-            self.active,
+            moving_ok,
             v,
             w,
             lambda i: self._plan(run, i, now_ns, replan=True),

@@ -6,6 +6,7 @@ from dataclasses import dataclass, field, fields, replace
 from typing import Any, get_type_hints
 
 from cosim.scenario.mapping import MappingConfig
+from cosim.scenario.mixed import MocapConfig, PhysicalConfig
 from cosim.scenario.network import NetworkConfig
 from cosim.scenario.sections import (
     AssignmentConfig,
@@ -38,6 +39,8 @@ class Scenario:
     tasks: TasksConfig = field(default_factory=TasksConfig)
     assignment: AssignmentConfig = field(default_factory=AssignmentConfig)
     mapping: MappingConfig = field(default_factory=MappingConfig)
+    mocap: MocapConfig = field(default_factory=MocapConfig)
+    physical: PhysicalConfig = field(default_factory=PhysicalConfig)
     record: RecordConfig = field(default_factory=RecordConfig)
     source: str = field(default="<defaults>", compare=False)
 

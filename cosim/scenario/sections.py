@@ -206,6 +206,11 @@ class NavigationConfig:
         gt=0,
     )
     progress_hz: float = param(1.0, "rate of `progress` status reports (Hz)", gt=0)
+    goals: tuple[tuple[float, float], ...] = param(
+        (),
+        "driver 'navigation': a series of goals [[x_m, y_m], ...] in map, visited in order "
+        "and round again (robot i starts at goal i); empty: random reachable goals",
+    )
 
 
 @dataclass(frozen=True)

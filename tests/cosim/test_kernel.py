@@ -113,3 +113,44 @@ def test_progress_is_reported_at_the_end_of_a_run():
     reports: list[tuple[int, int]] = []
     kernel.run(1_000_000, progress=lambda now, n: reports.append((now, n)))
     assert reports[-1] == (1_000_000, 1000)
+
+
+def test_a_realtime_kernel_records_one_lateness_entry_per_event_batch():
+    kernel = Kernel(realtime=True, speed=10.0)
+    seen = []
+    kernel.every(period_ns(100.0), seen.append, stage=Stage.CONTROL)
+    kernel.every(period_ns(100.0), seen.append, stage=Stage.SENSING)
+    kernel.run(50_000_000)  # 50 ms simulated = 5 ms of wall clock at speed 10
+    lateness = kernel.lateness
+    assert lateness is not None
+    assert list(lateness.t_ns) == [k * 10_000_000 for k in range(5)]
+    assert list(lateness.events) == [2] * 5  # two callbacks at every instant, one batch
+    assert all(late >= 0 for late in lateness.late_ns)
+
+
+def test_a_batch_that_overruns_makes_the_next_batch_late_by_that_much():
+    import time
+
+    kernel = Kernel(realtime=True)
+    kernel.at(0, lambda: time.sleep(0.05))  # 50 ms of work at t = 0
+    kernel.at(10_000_000, lambda: None)  # due 10 ms later
+    kernel.run(20_000_000)
+    lateness = kernel.lateness
+    assert lateness is not None
+    late_ms = [late / 1e6 for late in lateness.late_ns]
+    assert late_ms[0] < 20
+    assert 35 <= late_ms[1] < 200  # about 40 ms behind: recorded, not absorbed
+
+
+def test_a_kernel_that_is_not_realtime_measures_no_lateness():
+    kernel = Kernel()
+    kernel.run(1_000_000)
+    assert kernel.lateness is None
+    assert not kernel.realtime
+
+
+def test_wall_and_simulated_clocks_map_onto_each_other_at_the_kernel_speed():
+    kernel = Kernel(realtime=True, speed=2.0)
+    wall = kernel.wall_ns(4_000_000_000)
+    assert kernel.sim_ns(wall) == 4_000_000_000
+    assert kernel.wall_ns(4_000_000_000) - kernel.wall_ns(0) == 2_000_000_000

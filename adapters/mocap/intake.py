@@ -1,0 +1,135 @@
+"""The pose intake: every measured pose is checked before a robot's software or a twin uses it.
+
+Measured poses come from the simulated motion capture, a replayed recording, a live mocap
+system or a real robot over DDS. Each goes through the same checks, as a robot's
+localization would apply them: the values must be a pose (finite numbers), the stamp must
+be newer than the last accepted one, and the displacement must be one the robot can drive
+in the time between the two stamps (:class:`models.mocap.gate.PoseGate`). A rejected pose
+is recorded (``tables/mocap``) and dropped; an accepted one is published on
+``/<robot>/pose`` (``geometry_msgs/PoseStamped`` in ``map``) and, for a twin, becomes its
+ground truth.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from adapters.fleet.mirror import Mirrors
+from adapters.mocap.records import MocapRecords
+from adapters.naming import topic
+from cosim.adapter import RunContext
+from cosim.hosts import HostId
+from cosim.messages import PoseStamped
+from cosim.timebase import NS_PER_S
+from models.kinematics import FleetState
+from models.mocap.gate import PoseGate
+
+JUMP_TOLERANCE_RAD = 0.2
+"""Yaw change allowed beyond the yaw-rate limit between two poses (rad)."""
+
+
+def pose_topic(robot: str) -> str:
+    """The bus topic of the poses a robot localizes by."""
+    return topic(robot, "pose")
+
+
+class PoseIntake:
+    """Checks measured poses, records the rejected ones, publishes the accepted ones.
+
+    Args:
+        run: the run.
+        host: the host the poses are published from (the mocap server, or a robot).
+    """
+
+    def __init__(self, run: RunContext, host: HostId) -> None:
+        fleet = run.service(FleetState)
+        robots = run.scenario.robots
+        self.run = run
+        self.host = host
+        self.names = list(fleet.names)
+        self.index = {name: i for i, name in enumerate(self.names)}
+        self.gate = PoseGate(
+            max_speed_mps=max(robots.max_speed_mps, robots.max_reverse_mps),
+            max_yaw_rate_radps=robots.max_yaw_rate_radps,
+            tolerance_m=run.scenario.mocap.jump_tolerance_m,
+            tolerance_rad=JUMP_TOLERANCE_RAD,
+        )
+        n = len(self.names)
+        self.last = np.zeros((n, 3))
+        self.last_stamp_ns = np.zeros(n, dtype=np.int64)
+        self.has_last = np.zeros(n, dtype=bool)
+        self.records = MocapRecords.of(run)
+        self.mirrors = run.service(Mirrors)
+        self.topics = [pose_topic(name) for name in self.names]
+        self._advertised: set[int] = set()
+
+    def advertise(self, index: int) -> None:
+        """Announce robot ``index``'s pose topic (once)."""
+        if index not in self._advertised:
+            self.run.bus.advertise(self.topics[index], PoseStamped)
+            self._advertised.add(index)
+
+    def submit(
+        self,
+        index: int,
+        stamp_ns: int,
+        x_m: float,
+        y_m: float,
+        yaw_rad: float,
+        *,
+        mirror: bool,
+        now_ns: int | None = None,
+        host: HostId | None = None,
+    ) -> bool:
+        """Check one pose of robot ``index`` taken at ``stamp_ns``; publish it if good.
+
+        Args:
+            index: the robot.
+            stamp_ns: when the pose was measured (kernel ns).
+            x_m: x of the pose in ``map`` (m).
+            y_m: y of the pose in ``map`` (m).
+            yaw_rad: heading in ``map`` (rad).
+            mirror: the robot is a twin: an accepted pose becomes its ground truth.
+            now_ns: the kernel time (defaults to the kernel's now), for the records.
+            host: publish from this host instead of the intake's.
+
+        Returns:
+            Whether the pose was accepted.
+        """
+        now = self.run.kernel.now_ns if now_ns is None else now_ns
+        name = self.names[index]
+        if not all(math.isfinite(v) for v in (x_m, y_m, yaw_rad)):
+            self.records.row(now, name, "invalid", f"pose ({x_m}, {y_m}, {yaw_rad})")
+            return False
+        i = slice(index, index + 1)
+        verdict = self.gate.check(
+            self.last[i],
+            self.last_stamp_ns[i],
+            np.array([[x_m, y_m, yaw_rad]]),
+            np.array([stamp_ns], dtype=np.int64),
+            self.has_last[i],
+        )
+        if not bool(verdict.accepted[0]):
+            if bool(verdict.out_of_order[0]):
+                last_s = self.last_stamp_ns[index] / NS_PER_S
+                detail = f"stamp {stamp_ns / NS_PER_S:.6f} s not after {last_s:.6f} s"
+                self.records.row(now, name, "out_of_order", detail)
+            else:
+                moved = math.hypot(x_m - self.last[index, 0], y_m - self.last[index, 1])
+                dt = (stamp_ns - int(self.last_stamp_ns[index])) / NS_PER_S
+                self.records.row(now, name, "jump", f"{moved:.3f} m in {dt:.3f} s")
+            return False
+        self.last[index] = (x_m, y_m, yaw_rad)
+        self.last_stamp_ns[index] = stamp_ns
+        self.has_last[index] = True
+        if mirror:
+            self.mirrors.set(index, x_m, y_m, yaw_rad)
+        self.records.count("poses")
+        self.run.bus.publish(
+            self.topics[index],
+            PoseStamped(stamp_ns, "map", x_m, y_m, yaw_rad),
+            self.host if host is None else host,
+        )
+        return True

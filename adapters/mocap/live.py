@@ -1,0 +1,138 @@
+"""Live pose sources: a motion-capture system through ``motioncapture``, or ROS 2 over DDS.
+
+Both are polled from the kernel (no callback runs on another thread's time): each poll
+takes what arrived since the last one and maps its wall-clock stamps to kernel time with
+the real-time kernel's clock. Nothing received is trusted: samples that are not a pose
+are counted and dropped here, the rest go through the pose intake's checks.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Protocol
+
+from adapters.physical.session import dds_session
+from cosim.adapter import RunContext
+from cosim.mocap.live import MotionCaptureFeed, mock_bodies
+from cosim.ros2dds.qos import QosKind
+from cosim.ros2dds.types import PoseStamped as DdsPoseStamped
+from cosim.ros2dds.types import quaternion_to_yaw, stamp_ns
+from cosim.scenario.mixed import MocapConfig
+from models.kinematics import FleetState
+
+Sample = tuple[int, int, float, float, float]
+"""(robot index, stamp in kernel ns, x_m, y_m, yaw_rad) in ``map``."""
+
+QUATERNION_NORM_TOLERANCE = 0.05
+"""How far from 1 a pose's quaternion norm may be before the sample is refused."""
+
+
+class LiveSource(Protocol):
+    """What the mocap adapter polls."""
+
+    def take(self, now_ns: int) -> list[Sample]:
+        """The poses that arrived since the last call, oldest first."""
+        ...
+
+    def close(self) -> None:
+        """Disconnect."""
+        ...
+
+    def summary(self) -> dict[str, Any]:
+        """Counts for the run's summary."""
+        ...
+
+
+def pose_of(sample: DdsPoseStamped) -> tuple[int, float, float, float] | None:
+    """(wall stamp ns, x_m, y_m, yaw_rad) of a PoseStamped, or None if it is not a pose."""
+    p = sample.pose.position
+    q = sample.pose.orientation
+    values = (p.x, p.y, p.z, q.x, q.y, q.z, q.w)
+    if not all(math.isfinite(v) for v in values):
+        return None
+    norm = math.sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w)
+    if abs(norm - 1.0) > QUATERNION_NORM_TOLERANCE:
+        return None
+    return stamp_ns(sample.header.stamp), p.x, p.y, quaternion_to_yaw(q.x, q.y, q.z, q.w)
+
+
+class MotionCaptureSource:
+    """Rigid bodies of a live mocap system, one per tracked robot."""
+
+    def __init__(self, run: RunContext, cfg: MocapConfig, bodies: list[tuple[int, str]]) -> None:
+        self.kernel = run.kernel
+        self.index = {body: index for index, body in bodies}
+        options = {}
+        if cfg.system == "mock":
+            # a mock system holds each body where its robot starts (demos and tests)
+            fleet = run.service(FleetState)
+            options["rigid_bodies"] = mock_bodies(
+                {body: (fleet.x[i], fleet.y[i], fleet.yaw[i]) for body, i in self.index.items()}
+            )
+        self.feed = MotionCaptureFeed(
+            cfg.system, hostname=cfg.hostname, bodies=list(self.index), options=options
+        )
+
+    def take(self, now_ns: int) -> list[Sample]:
+        """Frames since the last poll, stamped on arrival (wall clock)."""
+        sim_ns = self.kernel.sim_ns
+        return [
+            (self.index[body], sim_ns(t_ns), x, y, yaw)
+            for t_ns, body, x, y, yaw in self.feed.drain()
+            if body in self.index
+        ]
+
+    def close(self) -> None:
+        """Stop the feed's thread."""
+        self.feed.close()
+
+    def summary(self) -> dict[str, Any]:
+        """Bodies never seen."""
+        return {"mocap_missing_bodies": len(self.feed.missing_bodies())}
+
+
+class Ros2PoseSource:
+    """PoseStamped topics over DDS, one per tracked robot (as ros2-vicon-receiver publishes)."""
+
+    def __init__(self, run: RunContext, bodies: list[tuple[int, str]]) -> None:
+        self.kernel = run.kernel
+        self.session = dds_session(run)
+        participant = self.session.participant
+        self.subscriptions = [
+            (index, participant.subscription(topic, DdsPoseStamped, QosKind.SENSOR_DATA))
+            for index, topic in bodies
+        ]
+        self.invalid = 0
+
+    def take(self, now_ns: int) -> list[Sample]:
+        """Samples since the last poll; stamps are the senders' (ROS time, wall clock)."""
+        sim_ns = self.kernel.sim_ns
+        out: list[Sample] = []
+        for index, subscription in self.subscriptions:
+            for sample in subscription.take():
+                pose = pose_of(sample)
+                if pose is None:
+                    self.invalid += 1
+                    continue
+                out.append((index, sim_ns(pose[0]), pose[1], pose[2], pose[3]))
+        return out
+
+    def close(self) -> None:
+        """Leave the DDS domain (shared with the physical bridge; closed once)."""
+        self.session.close()
+
+    def summary(self) -> dict[str, Any]:
+        """Samples refused before the intake, and those that failed to deserialize."""
+        return {
+            "mocap_dds_invalid": self.invalid,
+            "mocap_dds_malformed": sum(s.malformed for _, s in self.subscriptions),
+        }
+
+
+def open_live_source(
+    run: RunContext, cfg: MocapConfig, bodies: list[tuple[int, str]]
+) -> LiveSource:
+    """Connect the live source ``cfg.source`` names."""
+    if cfg.source == "motioncapture":
+        return MotionCaptureSource(run, cfg, bodies)
+    return Ros2PoseSource(run, bodies)

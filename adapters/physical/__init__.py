@@ -1,0 +1,1 @@
+"""Physical robots joining a run over ROS 2's wire protocol (DDS)."""

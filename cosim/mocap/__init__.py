@@ -1,0 +1,1 @@
+"""Motion capture outside the kernel: recorded pose tracks and live mocap systems."""
