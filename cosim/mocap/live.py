@@ -42,7 +42,8 @@ def mock_bodies(poses: dict[str, tuple[float, float, float]]) -> str:
     parts = []
     for name, (x, y, yaw) in poses.items():
         w, z = math.cos(yaw / 2), math.sin(yaw / 2)
-        parts.append(f"{name}({x!r},{y!r},0.0,{w!r},0.0,0.0,{z!r})")
+        values = ",".join(repr(float(v)) for v in (x, y, 0.0, w, 0.0, 0.0, z))
+        parts.append(f"{name}({values})")
     return ";".join(parts)
 
 
