@@ -10,7 +10,8 @@ STUDIES := runs/studies
 STUDY = $(BIN)/cosim study studies/$(1).toml --out $(STUDIES)/$(1) --resume
 
 .PHONY: setup demo test lint bench clean help reproduce study-comm study-comm-reduced \
-	study-burst study-scale study-paper study-nav study-mapping study-mapping-reduced map-aces
+	study-burst study-scale study-paper study-nav study-mapping study-mapping-reduced map-aces \
+	lab-real lab-mixed
 
 help:  ## list the targets
 	@grep -E '^[a-z-]+:.*##' $(MAKEFILE_LIST) | sed 's/:.*## /\t/'
@@ -37,11 +38,19 @@ lint: setup  ## ruff and mypy --strict
 bench: setup  ## benchmarks -> bench/results.json
 	$(BIN)/python bench/run.py --out bench/results.json
 
-reproduce: setup  ## Scenario 1, a reduced comm sweep and map sharing (about 6 min on 2 cores)
+reproduce: setup  ## Scenarios 1-3, a reduced comm sweep and map sharing (about 8 min on 2 cores)
 	$(call STUDY,paper)
 	$(call STUDY,comm_sweep_reduced)
 	$(call STUDY,map_sharing_reduced)
+	$(MAKE) --no-print-directory lab-real lab-mixed
 	@echo "reports: $(STUDIES)/paper/report.md $(STUDIES)/comm_sweep_reduced/report.md $(STUDIES)/map_sharing_reduced/report.md"
+	@echo "mixed reality: runs/lab-real-in-virtual/figures runs/lab-mixed/figures"
+
+lab-real: setup  ## Scenario 2: a stand-in physical robot through goals among virtual obstacles (1 min, real time)
+	$(BIN)/cosim run lab-real-in-virtual --standin --figures --force --out runs/lab-real-in-virtual
+
+lab-mixed: setup  ## Scenario 3: a stand-in physical robot and 3 virtual ones share tasks (1 min, real time)
+	$(BIN)/cosim run lab-mixed --standin --figures --force --out runs/lab-mixed
 
 study-comm: setup  ## the full comm sweep: 1,080 runs (about 30 min on 2 cores)
 	$(call STUDY,comm_sweep)

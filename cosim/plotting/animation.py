@@ -19,7 +19,7 @@ from matplotlib.lines import Line2D
 from PIL import Image
 
 from cosim.errors import ExportError
-from cosim.plotting.canvas import Color, robot_colors
+from cosim.plotting.canvas import Color, fleet_colors
 from cosim.plotting.fleet import FleetLayer, fleet_handles
 from cosim.plotting.rays import LidarRays
 from cosim.plotting.rundata import RunData
@@ -75,7 +75,7 @@ def animation_gif(
         ExportError: naming the path if the file cannot be written.
     """
     track = run.track
-    colors = robot_colors(len(track.robots))
+    colors = fleet_colors(list(track.robots), run.scenario.physical.robots)
     width, height = world_inches(run.warehouse, WORLD_IN)
     figure = Figure(figsize=(width + LEGEND_IN, height + 0.5), dpi=GIF_DPI, layout="constrained")
     canvas = FigureCanvasAgg(figure)

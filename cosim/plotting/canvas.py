@@ -62,6 +62,24 @@ def robot_colors(count: int) -> list[Color]:
     return [colormaps["turbo"](float(v)) for v in np.linspace(0.08, 0.92, count)]
 
 
+PHYSICAL_COLOR: Color = (0.84, 0.15, 0.16, 1.0)
+"""A physical robot's twin, red as in the paper's mixed-reality figures."""
+
+
+def fleet_colors(robots: list[str], physical: tuple[str, ...]) -> list[Color]:
+    """Colours of a fleet, robot by robot.
+
+    With physical robots, their twins are red and the virtual robots shades of green (the
+    paper's convention); otherwise every robot gets a distinct colour.
+    """
+    if not physical:
+        return robot_colors(len(robots))
+    virtual = [r for r in robots if r not in physical]
+    greens = [colormaps["Greens"](float(v)) for v in np.linspace(0.85, 0.45, max(len(virtual), 1))]
+    shade = iter(greens)
+    return [PHYSICAL_COLOR if r in physical else next(shade) for r in robots]
+
+
 def short_label(robot: str) -> str:
     """A robot's name shortened for labels on a crowded map: ``robot_12`` -> ``12``."""
     match = re.fullmatch(r"robot_(\d+)", robot)

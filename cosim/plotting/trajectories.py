@@ -11,7 +11,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from cosim.plotting.canvas import LEGEND_ROBOTS_MAX, Color, robot_colors, save_png
+from cosim.plotting.canvas import LEGEND_ROBOTS_MAX, Color, fleet_colors, save_png
 from cosim.plotting.fleet import TRAIL_S, WAITING_COLOR, FleetLayer, TaskTimes, fleet_handles
 from cosim.plotting.rundata import RunData
 from cosim.plotting.world import SHELF_MUTED, draw_world, world_handles, world_inches
@@ -37,7 +37,7 @@ def trajectories_figure(run: RunData, png_path: Path) -> Path:
         ExportError: naming the path if the file cannot be written.
     """
     track = run.track
-    colors = robot_colors(len(track.robots))
+    colors = fleet_colors(list(track.robots), run.scenario.physical.robots)
     width, height = world_inches(run.warehouse, WORLD_IN)
     figure = Figure(figsize=(width + LEGEND_IN + 0.8, height + 0.8), layout="constrained")
     ax = figure.add_subplot()
@@ -75,7 +75,7 @@ def snapshots_figure(run: RunData, times_s: Sequence[float], png_path: Path) -> 
         ExportError: naming the path if the file cannot be written.
     """
     track = run.track
-    colors = robot_colors(len(track.robots))
+    colors = fleet_colors(list(track.robots), run.scenario.physical.robots)
     count = len(times_s)
     cols = 2 if count == 4 else min(count, 3)
     rows = math.ceil(count / cols)
@@ -117,9 +117,13 @@ def _robot_lines(run: RunData, colors: list[Color]) -> list[Line2D]:
     if len(run.track.robots) > LEGEND_ROBOTS_MAX:
         return [Line2D([], [], color="0.4", label=f"{len(colors)} robots, a colour each")]
     return [
-        Line2D([], [], color=c, lw=1.3, label=name)
+        Line2D([], [], color=c, lw=1.3, label=_label(run, name))
         for name, c in zip(run.track.robots, colors, strict=True)
     ]
+
+
+def _label(run: RunData, robot: str) -> str:
+    return f"{robot} (physical)" if robot in run.scenario.physical.robots else robot
 
 
 def _marks(run: RunData) -> list[Line2D]:

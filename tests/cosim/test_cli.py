@@ -321,3 +321,25 @@ def test_a_delay_csv_next_to_the_scenario_is_found_and_used(tmp_path):
     done = cosim_cli("check", str(scenario), "--print", cwd=REPO_ROOT)
     assert done.returncode == 0, done.stderr
     assert f'latency_csv = "{tmp_path / "delays.csv"}"' in done.stdout
+
+
+def test_a_standin_with_a_negative_rate_is_one_line_and_exit_2(capsys):
+    assert main(["standin", "--name", "robot_1", "--rate-hz", "-1"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "rate_hz = -1.0" in err[0]
+
+
+def test_a_standin_on_a_domain_dds_cannot_have_is_one_line_and_exit_2(capsys):
+    assert main(["standin", "--name", "robot_1", "--domain", "300", "--duration-s", "1"]) == 2
+    assert "300" in capsys.readouterr().err
+
+
+def test_run_standin_without_a_physical_robot_is_refused(capsys, tmp_path):
+    assert main(["run", "lab-room", "--standin", "--out", str(tmp_path / "r"), "--quiet"]) == 2
+    assert "no physical robot" in capsys.readouterr().err
+    assert not (tmp_path / "r").exists()
+
+
+@pytest.mark.parametrize("preset", ["lab-real-in-virtual", "lab-mixed"])
+def test_the_mixed_reality_presets_check_without_touching_the_network(preset, capsys):
+    assert main(["check", preset]) == 0
