@@ -14,8 +14,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from adapters.fleet.mirror import Mirrors
 from adapters.mocap.records import MocapRecords
 from adapters.naming import topic
@@ -57,9 +55,9 @@ class PoseIntake:
             tolerance_rad=JUMP_TOLERANCE_RAD,
         )
         n = len(self.names)
-        self.last = np.zeros((n, 3))
-        self.last_stamp_ns = np.zeros(n, dtype=np.int64)
-        self.has_last = np.zeros(n, dtype=bool)
+        self.last = [(0.0, 0.0, 0.0)] * n
+        self.last_stamp_ns = [0] * n
+        self.has_last = [False] * n
         self.records = MocapRecords.of(run)
         self.mirrors = run.service(Mirrors)
         self.topics = [pose_topic(name) for name in self.names]
@@ -103,23 +101,20 @@ class PoseIntake:
         if not all(math.isfinite(v) for v in (x_m, y_m, yaw_rad)):
             self.records.row(now, name, "invalid", f"pose ({x_m}, {y_m}, {yaw_rad})")
             return False
-        i = slice(index, index + 1)
-        verdict = self.gate.check(
-            self.last[i],
-            self.last_stamp_ns[i],
-            np.array([[x_m, y_m, yaw_rad]]),
-            np.array([stamp_ns], dtype=np.int64),
-            self.has_last[i],
+        last = self.last[index] if self.has_last[index] else None
+        verdict = self.gate.check_one(
+            last, self.last_stamp_ns[index], (x_m, y_m, yaw_rad), stamp_ns
         )
-        if not bool(verdict.accepted[0]):
-            if bool(verdict.out_of_order[0]):
-                last_s = self.last_stamp_ns[index] / NS_PER_S
-                detail = f"stamp {stamp_ns / NS_PER_S:.6f} s not after {last_s:.6f} s"
-                self.records.row(now, name, "out_of_order", detail)
-            else:
-                moved = math.hypot(x_m - self.last[index, 0], y_m - self.last[index, 1])
-                dt = (stamp_ns - int(self.last_stamp_ns[index])) / NS_PER_S
-                self.records.row(now, name, "jump", f"{moved:.3f} m in {dt:.3f} s")
+        if verdict == "out_of_order":
+            last_s = self.last_stamp_ns[index] / NS_PER_S
+            detail = f"stamp {stamp_ns / NS_PER_S:.6f} s not after {last_s:.6f} s"
+            self.records.row(now, name, "out_of_order", detail)
+            return False
+        if verdict == "jump":
+            assert last is not None
+            moved = math.hypot(x_m - last[0], y_m - last[1])
+            dt = (stamp_ns - self.last_stamp_ns[index]) / NS_PER_S
+            self.records.row(now, name, "jump", f"{moved:.3f} m in {dt:.3f} s")
             return False
         self.last[index] = (x_m, y_m, yaw_rad)
         self.last_stamp_ns[index] = stamp_ns

@@ -9,6 +9,7 @@ limit is *stale* (it should stop).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -76,6 +77,31 @@ class PoseGate:
         turn = self.max_yaw_rate_radps * np.maximum(dt_s, 0.0) + self.tolerance_rad
         jump = has_last & ~out_of_order & ((moved > reach) | (turned > turn))
         return GateResult(~(out_of_order | jump), jump, out_of_order)
+
+    def check_one(
+        self,
+        last: tuple[float, float, float] | None,
+        last_stamp_ns: int,
+        new: tuple[float, float, float],
+        new_stamp_ns: int,
+    ) -> str:
+        """:meth:`check` for one pose without arrays (poses arrive one by one at 100 Hz).
+
+        Returns:
+            ``"ok"``, ``"jump"`` or ``"out_of_order"``; ``last`` None accepts any pose.
+        """
+        if last is None:
+            return "ok"
+        dt_s = (new_stamp_ns - last_stamp_ns) / 1e9
+        if dt_s <= 0:
+            return "out_of_order"
+        moved = math.hypot(new[0] - last[0], new[1] - last[1])
+        turned = abs((new[2] - last[2] + math.pi) % (2 * math.pi) - math.pi)
+        if moved > self.max_speed_mps * dt_s + self.tolerance_m:
+            return "jump"
+        if turned > self.max_yaw_rate_radps * dt_s + self.tolerance_rad:
+            return "jump"
+        return "ok"
 
 
 def stale(last_stamp_ns: IntArray, now_ns: int, max_age_ns: int, has_last: BoolArray) -> BoolArray:
