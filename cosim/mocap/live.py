@@ -21,9 +21,8 @@ import motioncapture
 
 from cosim.errors import BridgeError
 
-SYSTEMS = ("vicon", "optitrack", "optitrack_closed_source", "qualisys", "nokov", "vrpn",
-           "motionanalysis", "fzmotion", "mock")  # fmt: skip
-"""Backend names libmotioncapture knows (a given build may support fewer)."""
+SYSTEMS = ("vicon", "optitrack", "qualisys", "vrpn", "mock")
+"""Backends the motioncapture 1.1 wheel supports (others: "Unknown motion capture type!")."""
 
 BUFFER = 4096
 """Poses kept between two drains; older ones are dropped and counted."""
@@ -107,7 +106,7 @@ class MotionCaptureFeed:
                     continue
                 x, y = (float(v) for v in list(body.position)[:2])
                 q = body.rotation
-                if not (math.isfinite(x) and math.isfinite(y)):
+                if not all(math.isfinite(v) for v in (x, y, q.w, q.x, q.y, q.z)):
                     self.occluded += 1
                     continue
                 samples.append((now, name, x, y, quaternion_yaw(q.w, q.x, q.y, q.z)))

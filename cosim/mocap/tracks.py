@@ -165,10 +165,13 @@ def read_csv_track(path: Path) -> PoseTrack:
         TrackError: naming the file, the row (the header is row 1), the column and value.
     """
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")  # a spreadsheet's byte-order mark is fine
     except (OSError, UnicodeDecodeError) as error:
         raise TrackError(f"{path}: cannot read a pose track ({error})") from None
-    rows = list(csv.reader(text.splitlines()))
+    try:
+        rows = list(csv.reader(text.splitlines()))
+    except csv.Error as error:
+        raise TrackError(f"{path}: not a CSV pose track ({error})") from None
     if not rows:
         raise TrackError(f"{path}: empty; expected a header {','.join(CSV_COLUMNS)} and rows")
     header = [name.strip() for name in rows[0]]

@@ -90,6 +90,8 @@ class PoseGate:
         Returns:
             ``"ok"``, ``"jump"`` or ``"out_of_order"``; ``last`` None accepts any pose.
         """
+        if not all(math.isfinite(v) for v in new):
+            return "jump"  # not a pose at all: never accepted
         if last is None:
             return "ok"
         dt_s = (new_stamp_ns - last_stamp_ns) / 1e9

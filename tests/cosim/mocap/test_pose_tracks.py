@@ -116,3 +116,11 @@ def test_any_csv_reads_as_a_valid_track_or_fails_with_a_track_error(tmp_path_fac
         return
     assert len(track) >= 1 and np.all(np.diff(track.t_ns) > 0)
     assert np.isfinite(track.x_m).all() and np.isfinite(track.yaw_rad).all()
+
+
+def test_a_csv_with_a_byte_order_mark_reads_and_a_giant_cell_is_a_track_error(tmp_path: Path):
+    path = tmp_path / "bom.csv"
+    path.write_bytes("\ufefft_s,x_m,y_m,yaw_rad\n0,1,2,0\n".encode())
+    assert len(read_csv_track(path)) == 1
+    with pytest.raises(TrackError, match="not a CSV"):
+        read_csv_track(write(tmp_path, "t_s,x_m,y_m,yaw_rad\n" + '"' + "1" * 200_000 + '"\n'))

@@ -73,3 +73,8 @@ def test_a_pose_is_stale_only_once_it_is_older_than_the_limit():
     has = np.array([True, True, False])
     assert stale(stamps, 200, 200, has).tolist() == [False, False, True]
     assert stale(stamps, 201, 200, has).tolist() == [True, True, True]
+
+
+def test_the_one_pose_gate_never_accepts_a_pose_that_is_not_a_number():
+    assert GATE.check_one(None, 0, (math.nan, 1.0, 0.0), 1) == "jump"
+    assert GATE.check_one((0.0, 0.0, 0.0), 0, (0.0, 0.0, math.inf), 10**9) == "jump"
