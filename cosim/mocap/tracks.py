@@ -20,6 +20,7 @@ import numpy.typing as npt
 
 from cosim.errors import BagError, CosimError
 from cosim.recording.reading import bag_info, read_messages
+from models.mocap.sampling import wrap_yaw
 
 POSE_TYPES = (
     "geometry_msgs/msg/PoseStamped",
@@ -223,5 +224,5 @@ def read_csv_track(path: Path) -> PoseTrack:
     t_ns = np.round(array[:, 0] * 1e9).astype(np.int64)
     if np.any(np.diff(t_ns) <= 0):
         raise TrackError(f"{path}: two rows closer than 1 ns in time; expected distinct times")
-    headings = (array[:, 3] + np.pi) % (2 * np.pi) - np.pi
+    headings = wrap_yaw(array[:, 3])
     return PoseTrack(t_ns, array[:, 1], array[:, 2], headings, "", str(path), "csv")

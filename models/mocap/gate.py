@@ -27,7 +27,8 @@ class GateResult:
 
     Attributes:
         accepted: the pose can be used.
-        jump: rejected, further than the robot can move in the time between stamps.
+        jump: rejected, further than the robot can move in the time between stamps, or
+            not a pose at all (NaN or infinite).
         out_of_order: rejected, stamped at or before the last accepted pose.
     """
 
@@ -67,15 +68,19 @@ class PoseGate:
             last_stamp_ns: (n,) their stamps (ns).
             new: (n, 3) the poses to check.
             new_stamp_ns: (n,) their stamps (ns).
-            has_last: (n,) whether a robot has an accepted pose at all (else accepted).
+            has_last: (n,) whether a robot has an accepted pose at all (else any finite
+                pose is accepted).
         """
+        # a NaN or infinite pose is not a pose at all: never accepted (as check_one)
+        finite = np.isfinite(new).all(axis=1)
         dt_s = (np.asarray(new_stamp_ns) - np.asarray(last_stamp_ns)) / 1e9
-        out_of_order = has_last & (dt_s <= 0)
-        moved = np.hypot(new[:, 0] - last[:, 0], new[:, 1] - last[:, 1])
-        turned = np.abs((new[:, 2] - last[:, 2] + np.pi) % (2 * np.pi) - np.pi)
+        out_of_order = finite & has_last & (dt_s <= 0)
+        with np.errstate(invalid="ignore"):  # non-finite rows are rejected above
+            moved = np.hypot(new[:, 0] - last[:, 0], new[:, 1] - last[:, 1])
+            turned = np.abs((new[:, 2] - last[:, 2] + np.pi) % (2 * np.pi) - np.pi)
         reach = self.max_speed_mps * np.maximum(dt_s, 0.0) + self.tolerance_m
         turn = self.max_yaw_rate_radps * np.maximum(dt_s, 0.0) + self.tolerance_rad
-        jump = has_last & ~out_of_order & ((moved > reach) | (turned > turn))
+        jump = ~finite | (has_last & ~out_of_order & ((moved > reach) | (turned > turn)))
         return GateResult(~(out_of_order | jump), jump, out_of_order)
 
     def check_one(
