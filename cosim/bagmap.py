@@ -24,6 +24,7 @@ import numpy.typing as npt
 import pandas as pd
 
 from cosim.errors import BagError, ExportError
+from cosim.mocap.tracks import planar_pose
 from cosim.recording.reading import BagMessage, bag_info, read_messages
 from cosim.worldfiles import write_map
 from models.mapping.grid import LogOddsMap, MapGeometry
@@ -101,11 +102,7 @@ def _stamp_ns(message: BagMessage) -> int:
 
 
 def _pose(message: BagMessage) -> tuple[float, float, float]:
-    pose = message.message.pose
-    pose = getattr(pose, "pose", pose)  # Odometry and PoseWithCovarianceStamped nest a Pose
-    q = pose.orientation
-    yaw = math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z))
-    return float(pose.position.x), float(pose.position.y), yaw
+    return planar_pose(message.message, message.msgtype)
 
 
 def _check_types(bag: Path, wanted: Sequence[tuple[str, str, Sequence[str]]]) -> None:

@@ -8,7 +8,6 @@ are counted and dropped here, the rest go through the pose intake's checks.
 
 from __future__ import annotations
 
-import math
 from typing import Any, Protocol
 
 from adapters.physical.session import dds_session
@@ -16,15 +15,12 @@ from cosim.adapter import RunContext
 from cosim.mocap.live import MotionCaptureFeed, mock_bodies
 from cosim.ros2dds.qos import QosKind
 from cosim.ros2dds.types import PoseStamped as DdsPoseStamped
-from cosim.ros2dds.types import quaternion_to_yaw, stamp_ns
+from cosim.ros2dds.types import planar_pose
 from cosim.scenario.mixed import MocapConfig
 from models.kinematics import FleetState
 
 Sample = tuple[int, int, float, float, float]
 """(robot index, stamp in kernel ns, x_m, y_m, yaw_rad) in ``map``."""
-
-QUATERNION_NORM_TOLERANCE = 0.05
-"""How far from 1 a pose's quaternion norm may be before the sample is refused."""
 
 
 class LiveSource(Protocol):
@@ -41,19 +37,6 @@ class LiveSource(Protocol):
     def summary(self) -> dict[str, Any]:
         """Counts for the run's summary."""
         ...
-
-
-def pose_of(sample: DdsPoseStamped) -> tuple[int, float, float, float] | None:
-    """(wall stamp ns, x_m, y_m, yaw_rad) of a PoseStamped, or None if it is not a pose."""
-    p = sample.pose.position
-    q = sample.pose.orientation
-    values = (p.x, p.y, p.z, q.x, q.y, q.z, q.w)
-    if not all(math.isfinite(v) for v in values):
-        return None
-    norm = math.sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w)
-    if abs(norm - 1.0) > QUATERNION_NORM_TOLERANCE:
-        return None
-    return stamp_ns(sample.header.stamp), p.x, p.y, quaternion_to_yaw(q.x, q.y, q.z, q.w)
 
 
 class MotionCaptureSource:
@@ -110,7 +93,7 @@ class Ros2PoseSource:
         out: list[Sample] = []
         for index, subscription in self.subscriptions:
             for sample in subscription.take():
-                pose = pose_of(sample)
+                pose = planar_pose(sample.header, sample.pose)
                 if pose is None:
                     self.invalid += 1
                     continue

@@ -27,7 +27,7 @@ import simpy
 from adapters.mocap.intake import PoseIntake
 from adapters.mocap.live import LiveSource, open_live_source
 from adapters.mocap.records import MocapRecords
-from adapters.mocap.tracking import external_bodies
+from adapters.mocap.tracking import external_bodies, simulated_robots
 from cosim.adapter import RunContext
 from cosim.errors import ConfigError
 from cosim.hosts import HostKind
@@ -64,7 +64,8 @@ class MocapAdapter:
         self._live_summary: dict[str, Any] = {}
         self.tracks: list[tuple[int, PoseTrack]] = []
         if cfg.source == "simulated":
-            self.tracked = self._indices(cfg.robots or tuple(self.fleet.names), "robots")
+            by_name = self.intake.index
+            self.tracked = [by_name[r] for r in simulated_robots(run.scenario, self.fleet.names)]
             streams = [run.rng.stream(f"mocap/{self.fleet.names[i]}") for i in self.tracked]
             self._normals = BlockDraws(streams, width=3)
             self._uniforms = BlockDraws(
@@ -92,16 +93,6 @@ class MocapAdapter:
                 ]
         for index in self.tracked:
             self.intake.advertise(index)
-
-    def _indices(self, names: tuple[str, ...], key: str) -> list[int]:
-        index = self.intake.index
-        unknown = [name for name in names if name not in index]
-        if unknown:
-            raise ConfigError(
-                f"{self.source}: [mocap] {key} names {unknown[0]!r}: expected one of the "
-                f"robots {', '.join(self.fleet.names)}"
-            )
-        return [index[name] for name in names]
 
     def _bodies(self, run: RunContext) -> list[tuple[int, str]]:
         """(robot index, body) pairs of an external source, defaults filled in."""

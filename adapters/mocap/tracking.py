@@ -70,11 +70,22 @@ def physical_robots(scenario: Scenario, names: list[str]) -> list[str]:
     return robots
 
 
+def simulated_robots(scenario: Scenario, names: list[str]) -> list[str]:
+    """The robots a simulated mocap tracks (``mocap.robots``, or all).
+
+    Raises:
+        ConfigError: for a robot that is not in the fleet.
+    """
+    tracked = list(scenario.mocap.robots) or list(names)
+    _check_names(scenario, names, tracked, "mocap.robots")
+    return tracked
+
+
 def tracked_robots(scenario: Scenario, names: list[str]) -> list[str]:
     """The robots whose software localizes by measured poses on ``/<robot>/pose``."""
     cfg = scenario.mocap
     if cfg.source == "simulated":
-        tracked = list(cfg.robots) or list(names)
+        tracked = simulated_robots(scenario, names)
     else:
         tracked = [robot for robot, _ in external_bodies(scenario, names)]
     if scenario.physical.pose == "odom":

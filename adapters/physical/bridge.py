@@ -40,21 +40,6 @@ from cosim.ros2dds.qos import QosKind
 from cosim.timebase import period_ns
 from models.kinematics import FleetState
 
-QUATERNION_NORM_TOLERANCE = 0.05
-"""How far from 1 a received quaternion's norm may be before the sample is refused."""
-
-
-def odom_pose(sample: dds.Odometry) -> tuple[int, float, float, float] | None:
-    """(wall stamp ns, x_m, y_m, yaw_rad) of an Odometry sample, or None if not a pose."""
-    p = sample.pose.pose.position
-    q = sample.pose.pose.orientation
-    if not all(math.isfinite(v) for v in (p.x, p.y, p.z, q.x, q.y, q.z, q.w)):
-        return None
-    norm = math.sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w)
-    if abs(norm - 1.0) > QUATERNION_NORM_TOLERANCE:
-        return None
-    return dds.stamp_ns(sample.header.stamp), p.x, p.y, dds.quaternion_to_yaw(q.x, q.y, q.z, q.w)
-
 
 class PhysicalRobot:
     """The DDS endpoints of one physical robot."""
@@ -163,7 +148,7 @@ class PhysicalAdapter:
         for robot in self.robots:
             assert robot.odom is not None
             for sample in robot.odom.take():
-                pose = odom_pose(sample)
+                pose = dds.planar_pose(sample.header, sample.pose.pose)
                 if pose is None:
                     robot.invalid += 1
                     continue

@@ -20,6 +20,7 @@ from types import TracebackType
 import motioncapture
 
 from cosim.errors import BridgeError
+from models.mapping.se2 import yaw_of_quaternion
 
 SYSTEMS = ("vicon", "optitrack", "qualisys", "vrpn", "mock")
 """Backends the motioncapture 1.1 wheel supports (others: "Unknown motion capture type!")."""
@@ -32,8 +33,8 @@ Sample = tuple[int, str, float, float, float]
 
 
 def quaternion_yaw(w: float, x: float, y: float, z: float) -> float:
-    """Yaw (rad) of a rotation quaternion (libmotioncapture gives w, x, y, z)."""
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    """Yaw (rad) of a rotation quaternion in libmotioncapture's order (w, x, y, z)."""
+    return yaw_of_quaternion(x, y, z, w)
 
 
 def mock_bodies(poses: dict[str, tuple[float, float, float]]) -> str:

@@ -20,6 +20,7 @@ import numpy.typing as npt
 
 from cosim.errors import BagError, CosimError
 from cosim.recording.reading import bag_info, read_messages
+from models.mapping.se2 import yaw_of_quaternion
 from models.mocap.sampling import wrap_yaw
 
 POSE_TYPES = (
@@ -69,13 +70,12 @@ class PoseTrack:
         return np.asarray(self.t_ns - self.t_ns[0], dtype=np.int64)
 
 
-def yaw_of(x: float, y: float, z: float, w: float) -> float:
-    """Yaw (rad) of a quaternion (rotation about z, REP 103)."""
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+yaw_of = yaw_of_quaternion
+"""Yaw (rad) of a quaternion ``(x, y, z, w)``."""
 
 
 def _planar(message: Any, msgtype: str) -> tuple[Any, Any, Any]:
-    """(header, position-like, quaternion) of a pose-like message."""
+    """(header, position-like, quaternion) of a pose-like message (one of POSE_TYPES)."""
     if msgtype == "geometry_msgs/msg/PoseStamped":
         return message.header, message.pose.position, message.pose.orientation
     if msgtype == "geometry_msgs/msg/TransformStamped":
@@ -83,6 +83,12 @@ def _planar(message: Any, msgtype: str) -> tuple[Any, Any, Any]:
         return message.header, t.translation, t.rotation
     # PoseWithCovarianceStamped and Odometry both hold a PoseWithCovariance
     return message.header, message.pose.pose.position, message.pose.pose.orientation
+
+
+def planar_pose(message: Any, msgtype: str) -> tuple[float, float, float]:
+    """x_m, y_m, yaw_rad of a decoded pose-like message (one of :data:`POSE_TYPES`)."""
+    _header, p, q = _planar(message, msgtype)
+    return float(p.x), float(p.y), yaw_of_quaternion(q.x, q.y, q.z, q.w)
 
 
 def pose_topics(path: str | Path) -> dict[str, str]:
@@ -134,10 +140,10 @@ def read_pose_track(path: str | Path, topic: str | None = None) -> PoseTrack:
     poses: list[tuple[float, float, float]] = []
     frame = ""
     for m in read_messages(path, [topic]):
-        header, p, q = _planar(m.message, msgtype)
+        header = _planar(m.message, msgtype)[0]
         header_ns.append(int(header.stamp.sec) * 1_000_000_000 + int(header.stamp.nanosec))
         log_ns.append(m.t_ns)
-        poses.append((float(p.x), float(p.y), yaw_of(q.x, q.y, q.z, q.w)))
+        poses.append(planar_pose(m.message, msgtype))
         frame = frame or str(header.frame_id)
     source = f"{path} {topic}"
     if not poses:

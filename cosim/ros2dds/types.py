@@ -19,6 +19,8 @@ from cyclonedds.idl import IdlStruct
 from cyclonedds.idl import types as idl
 from cyclonedds.idl.annotations import final
 
+from models.mapping.se2 import yaw_of_quaternion
+
 Covariance = Annotated[Sequence[idl.float64], idl.array(idl.float64, 36)]
 """Row-major 6x6 covariance over (x, y, z, rot x, rot y, rot z)."""
 Float32Sequence = Annotated[Sequence[idl.float32], idl.sequence(idl.float32)]
@@ -199,9 +201,26 @@ def yaw_to_quaternion(yaw: float) -> tuple[float, float, float, float]:
     return (0.0, 0.0, math.sin(0.5 * yaw), math.cos(0.5 * yaw))
 
 
-def quaternion_to_yaw(x: float, y: float, z: float, w: float) -> float:
-    """The yaw (rad, in [-pi, pi]) of a quaternion: its rotation about z, as tf2 computes it."""
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+quaternion_to_yaw = yaw_of_quaternion
+"""The yaw (rad, in [-pi, pi]) of a quaternion ``(x, y, z, w)``, as tf2 computes it."""
+
+QUATERNION_NORM_TOLERANCE = 0.05
+"""How far from 1 a received quaternion's norm may be before the sample is refused."""
+
+
+def planar_pose(header: Header, pose: Pose) -> tuple[int, float, float, float] | None:
+    """(stamp ns, x_m, y_m, yaw_rad) of a received pose, or None if it is not a pose.
+
+    Received samples are untrusted: any non-finite value, or a quaternion whose norm is
+    off 1 by more than :data:`QUATERNION_NORM_TOLERANCE`, and the sample is refused.
+    """
+    p, q = pose.position, pose.orientation
+    if not all(math.isfinite(v) for v in (p.x, p.y, p.z, q.x, q.y, q.z, q.w)):
+        return None
+    norm = math.sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w)
+    if abs(norm - 1.0) > QUATERNION_NORM_TOLERANCE:
+        return None
+    return stamp_ns(header.stamp), p.x, p.y, quaternion_to_yaw(q.x, q.y, q.z, q.w)
 
 
 def stamp(ns: int) -> Time:

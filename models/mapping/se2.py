@@ -25,6 +25,11 @@ def relative(a: Pose, b: Pose) -> Pose:
     return compose(inverse(a), b)
 
 
+def yaw_of_quaternion(x: float, y: float, z: float, w: float) -> float:
+    """Yaw (rad, in [-pi, pi]) of a unit quaternion: its rotation about z (REP 103, as tf2)."""
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
 def wrap(angle: float) -> float:
     """An angle in [-pi, pi)."""
     return (angle + math.pi) % (2.0 * math.pi) - math.pi

@@ -10,6 +10,8 @@ import time
 from pathlib import Path
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from cosim.errors import ConfigError
 from cosim.ros2dds.participant import RosParticipant
@@ -176,3 +178,30 @@ def test_the_command_line_prints_a_one_line_summary_after_a_run(capsys, domain):
     last = capsys.readouterr().out.strip().splitlines()[-1]
     assert last.startswith("robot_4: ") and "0 cmd_vel" in last
     assert signal.getsignal(signal.SIGTERM) is handler  # restored for whoever called main
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.text(max_size=12),
+    st.integers(-5, 300),
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.floats(allow_nan=True, allow_infinity=True),
+)
+def test_any_standin_options_build_or_fail_with_a_config_error(name, domain, rate, speed, noise):
+    import argparse
+
+    from cosim.standin import FLOAT_OPTIONS, options_from
+
+    values = {key: 0.0 for key in FLOAT_OPTIONS}
+    values.update(rate_hz=rate, max_speed_mps=speed, noise_std_m=noise)
+    values.update(max_yaw_rate_radps=2.0, cmd_timeout_s=0.5)
+    args = argparse.Namespace(
+        name=name, domain=domain, interface=None, seed=1, duration_s=None, **values
+    )
+    try:
+        options = options_from(args)
+    except ConfigError as error:
+        assert "\n" not in str(error)
+        return
+    assert options.rate_hz > 0 and options.max_speed_mps > 0 and options.noise_std_m >= 0

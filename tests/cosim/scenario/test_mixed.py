@@ -133,3 +133,11 @@ def test_any_mocap_or_physical_values_load_or_fail_with_a_config_error(overrides
         physical_robots(s, NAMES)
     except ConfigError:
         pass
+
+
+def test_a_series_goal_outside_the_room_is_named_before_the_run():
+    from cosim.assembly import assemble
+
+    s = load_scenario("lab-real-in-virtual", {"navigation.goals": [[1.0, 1.0], [5.0, 2.0]]})
+    with pytest.raises(ConfigError, match=r"goals has \[5, 2\]: expected points inside"):
+        assemble(s)
