@@ -47,6 +47,8 @@ def adapter_names(scenario: Scenario, *, recording: bool = False) -> list[str]:
         names.append("mocap")
     if scenario.physical.robots:
         names.append("physical")
+    if scenario.humans.enabled:
+        names.append("humans")
     names += DRIVERS[driver] + ["poses"]
     if recording:
         names.append("ros_interface")

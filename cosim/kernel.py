@@ -32,13 +32,15 @@ class Stage(IntEnum):
 
     PHYSICS = 2
     """Kinematics integration and ground-truth contact checks."""
-    DELIVERY = 3
+    PEOPLE = 3
+    """People and vehicles moved by another simulator (SUMO), after the robots moved."""
+    DELIVERY = 4
     """Bus messages arriving over a link."""
-    SENSING = 4
+    SENSING = 5
     """Sensors sampling the ground truth (lidar, motion capture, odometry)."""
-    CONTROL = 5
+    CONTROL = 6
     """Robot software: controllers, planners, protocols."""
-    RECORD = 6
+    RECORD = 7
     """Samplers that write ground truth into the tables."""
 
 

@@ -159,6 +159,7 @@ class Recorder:
         self.tables: dict[str, Table] = {}
         self.volatile: dict[str, tuple[str, ...]] = {}
         self.maps: dict[str, MapArtifact] = {}
+        self.files: dict[str, bytes] = {}
         self.counts: dict[str, int] = {status.value: 0 for status in DeliveryStatus}
         self.network_messages = 0
         self.network_bytes = 0
@@ -244,6 +245,12 @@ class Recorder:
         if name in self.maps:
             raise ValueError(f"map {name!r} exists already")
         self.maps[name] = grid
+
+    def add_file(self, relative: str, data: bytes) -> None:
+        """Keep a file for the run folder, at ``relative`` (e.g. ``sumo/aisles.net.xml``)."""
+        if relative in self.files:
+            raise ValueError(f"file {relative!r} exists already")
+        self.files[relative] = data
 
     # -- export ----------------------------------------------------------------------
     def messages_frame(self) -> pd.DataFrame:

@@ -31,7 +31,7 @@ from models.occupancy import OccupancyGrid
 ProgressFn = Callable[[float, float, float], None]
 """Progress callback: (sim time s, duration s, wall time s)."""
 
-OUTPUTS = ("summary.json", "scenario.toml", "tables", "figures", "bag", "maps")
+OUTPUTS = ("summary.json", "scenario.toml", "tables", "figures", "bag", "maps", "sumo")
 """What a run writes into its folder (``--force`` removes exactly these)."""
 
 
@@ -47,6 +47,7 @@ class RunResult:
         bag: the bag directory, when one was written.
         recorded: messages recorded per topic (bag or live view).
         maps: final occupancy maps by name (written as ``maps/NAME.yaml`` + ``.pgm``).
+        files: other files for the run folder by relative path (SUMO's ``sumo/...``).
     """
 
     scenario: Scenario
@@ -57,6 +58,7 @@ class RunResult:
     bag: Path | None = None
     recorded: dict[str, int] = field(default_factory=dict, repr=False)
     maps: dict[str, MapArtifact] = field(default_factory=dict, repr=False)
+    files: dict[str, bytes] = field(default_factory=dict, repr=False)
 
     def deterministic_tables(self) -> dict[str, pd.DataFrame]:
         """The tables without their wall-clock columns: equal for equal scenario and seed."""
@@ -181,6 +183,7 @@ def _run_assembled(
         run.recorder.frames(),
         volatile=run.recorder.volatile,
         maps=dict(run.recorder.maps),
+        files=dict(run.recorder.files),
     )
 
 
@@ -243,6 +246,10 @@ def write_run(result: RunResult, out: Path, *, tables: bool = True) -> None:
                 OccupancyGrid(grid.resolution_m, grid.origin_xy_m, grid.data),
                 partial / "maps" / f"{name}.yaml",
             )
+        for relative, data in result.files.items():
+            target = partial / relative
+            target.parent.mkdir(parents=True, exist_ok=True)
+            target.write_bytes(data)
         (partial / "summary.json").write_text(
             json.dumps(result.summary, indent=2, allow_nan=False) + "\n", encoding="utf-8"
         )

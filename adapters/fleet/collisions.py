@@ -66,7 +66,7 @@ class CollisionsAdapter:
             return self.static_names[p.other], self.static_kinds[p.other]
         if p.kind is OtherKind.ROBOT:
             return self.fleet.names[p.other], "robot"
-        return self.dynamic.names[p.other], "dynamic"
+        return self.dynamic.names[p.other], self.dynamic.kind(p.other)
 
     def guard(self, now_ns: int, motion: Motion) -> None:
         """Hold robots whose proposed pose overlaps something; record new contacts.

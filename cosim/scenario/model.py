@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, fields, replace
 from typing import Any, get_type_hints
 
+from cosim.scenario.humans import HumansConfig
 from cosim.scenario.mapping import MappingConfig
 from cosim.scenario.mixed import MocapConfig, PhysicalConfig
 from cosim.scenario.network import NetworkConfig
@@ -41,6 +42,7 @@ class Scenario:
     mapping: MappingConfig = field(default_factory=MappingConfig)
     mocap: MocapConfig = field(default_factory=MocapConfig)
     physical: PhysicalConfig = field(default_factory=PhysicalConfig)
+    humans: HumansConfig = field(default_factory=HumansConfig)
     record: RecordConfig = field(default_factory=RecordConfig)
     source: str = field(default="<defaults>", compare=False)
 

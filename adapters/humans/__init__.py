@@ -1,0 +1,1 @@
+"""People and forklifts co-simulated with SUMO: the adapter and its records."""

@@ -1,0 +1,97 @@
+"""What the humans adapter records: ``tables/humans``, near misses, stops, summary keys.
+
+``tables/humans`` has one row per person (or forklift) and sample: t_s, id, kind
+(``person`` | ``forklift``), x_m, y_m, yaw_rad (``map``), speed_mps, at ``humans.record_hz``
+(at most one per SUMO step). Near misses and stops caused by people are events
+(``near_miss``, ``stopped_by_person``) with the person's id and the clearance.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from cosim.adapter import RunContext
+from cosim.scenario.humans import HumansConfig
+from cosim.timebase import NS_PER_S, period_ns
+from models.humans.encounters import Encounters
+from models.kinematics import FleetState
+from models.obstacles import DynamicObstacles
+
+if TYPE_CHECKING:
+    from adapters.humans.traffic import People
+
+HUMAN_COLUMNS = ("t_s", "id", "kind", "x_m", "y_m", "yaw_rad", "speed_mps")
+PEOPLE_KINDS = ("person", "forklift")
+
+
+class HumanRecords:
+    """Samples people into the table and keeps the robot-person encounter metrics."""
+
+    def __init__(self, run: RunContext, cfg: HumansConfig) -> None:
+        self.fleet = run.service(FleetState)
+        self.recorder = run.recorder
+        self.table = run.recorder.table("humans", HUMAN_COLUMNS, categorical=("id", "kind"))
+        self.encounters = Encounters(cfg.near_miss_m, cfg.stop_radius_m)
+        self.record_ns = period_ns(cfg.record_hz)
+        self.next_record_ns = 0
+        self.near_misses = 0
+        self.stops = 0
+        self.robot_stops = np.zeros(len(self.fleet), dtype=np.int64)
+        self.seen: set[str] = set()
+
+    def sample(self, now_ns: int, people: People, dynamic: DynamicObstacles) -> None:
+        """Take the people at ``now_ns`` into the table and the metrics."""
+        t_s = now_ns / NS_PER_S
+        if now_ns >= self.next_record_ns and people.names:
+            n = len(people.names)
+            self.table.extend(
+                t_s=np.full(n, t_s),
+                id=people.names,
+                kind=people.kinds,
+                x_m=people.x_m,
+                y_m=people.y_m,
+                yaw_rad=people.yaw_rad,
+                speed_mps=people.speed_mps,
+            )
+            self.next_record_ns = now_ns + self.record_ns
+        self.seen.update(people.names)
+        fleet = self.fleet
+        robots = np.column_stack([fleet.x, fleet.y, fleet.radius_m])
+        discs = dynamic.discs
+        names = dynamic.names
+        mine = [k for k, name in enumerate(names) if dynamic.kind(k) in PEOPLE_KINDS]
+        began, stops = self.encounters.update(
+            robots, fleet.v, discs[mine], [names[k] for k in mine]
+        )
+        for e in began:
+            self.near_misses += 1
+            self.recorder.event(
+                now_ns, fleet.names[e.robot], "near_miss", f"{e.person} at {e.clearance_m:.2f} m"
+            )
+        for e in stops:
+            self.stops += 1
+            self.robot_stops[e.robot] += 1
+            self.recorder.event(
+                now_ns,
+                fleet.names[e.robot],
+                "stopped_by_person",
+                f"{e.person} at {e.clearance_m:.2f} m",
+            )
+
+    def summary(self, run: RunContext) -> dict[str, Any]:
+        """Minimum distance, near misses, stops and contacts with people."""
+        least = self.encounters.min_clearance_m
+        contacts = 0
+        table = run.recorder.tables.get("collisions")
+        if table is not None and len(table):
+            frame = table.frame()
+            contacts = int(frame["kind"].isin(PEOPLE_KINDS).sum())
+        return {
+            "humans_seen": len(self.seen),
+            "humans_min_distance_m": round(least, 4) if np.isfinite(least) else None,
+            "humans_near_misses": self.near_misses,
+            "humans_robot_stops": self.stops,
+            "humans_collisions": contacts,
+        }

@@ -1,0 +1,248 @@
+"""The humans adapter: workers and forklifts from SUMO, stepped in lockstep with the kernel.
+
+At construction it builds the aisle graph of the warehouse, draws the demand from the
+``humans/demand`` stream, writes SUMO's files (network through netconvert, demand,
+config) and keeps them for the run folder's ``sumo/``.
+
+**Synchronization.** Every ``humans.step_length_s`` (Δ) at instant t_k = kΔ, in the
+``PEOPLE`` stage (after the robots' physics step of that instant, before any sensor):
+
+1. the robots' mirrors in SUMO are placed at the robots' true poses at t_k;
+2. SUMO advances from t_(k-1) to t_k, its people reacting to the mirrors as placed;
+3. people and forklifts at t_k become the run's dynamic obstacles, seen by every lidar
+   and collision check until t_(k+1) (sample and hold).
+
+There is no lookahead: SUMO never runs ahead of the kernel. People react to robots with
+a delay of up to one step; between steps cosim holds a person where SUMO put them at
+t_k, so the true position differs from the held one by at most v·Δ (0.12 m for a worker
+at 1.2 m/s and Δ = 0.1 s, 0.22 m for a forklift at 2.2 m/s). Lidar ranges and
+clearances to people carry that error.
+"""
+
+from __future__ import annotations
+
+import shutil
+import tempfile
+import time
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+
+from adapters.humans.records import HumanRecords
+from cosim.adapter import RunContext
+from cosim.errors import ScenarioError
+from cosim.humans.files import (
+    TrafficTypes,
+    write_config,
+    write_demand,
+    write_network,
+)
+from cosim.humans.session import Movers, SumoSession
+from cosim.kernel import Stage
+from cosim.timebase import NS_PER_S, period_ns
+from models.errors import ModelError
+from models.humans.aisles import AisleGraph, aisle_graph, dock_points, pick_stations
+from models.humans.demand import Plan, plans, standing_plans
+from models.kinematics import FleetState
+from models.obstacles import DynamicObstacles
+from models.world import Warehouse
+
+CLEARANCE_MARGIN_M = 0.1
+"""Aisle lines keep a worker's radius plus this from shelves and walls (m)."""
+
+
+class People:
+    """The people and forklifts now, for other adapters (markers, figures).
+
+    Attributes:
+        names: their ids.
+        kinds: ``person`` or ``forklift`` per id.
+        x_m, y_m, yaw_rad, speed_mps: their poses and speeds (``map``).
+    """
+
+    def __init__(self) -> None:
+        self.names: list[str] = []
+        self.kinds: list[str] = []
+        self.x_m = np.zeros(0)
+        self.y_m = np.zeros(0)
+        self.yaw_rad = np.zeros(0)
+        self.speed_mps = np.zeros(0)
+        self.forklift_size_m = (0.0, 0.0)
+        self.worker_radius_m = 0.0
+
+
+class HumansAdapter:
+    """People and forklifts in the aisles, co-simulated with SUMO through libsumo."""
+
+    name: ClassVar[str] = "humans"
+    requires: ClassVar[tuple[str, ...]] = ("world", "fleet")
+
+    def __init__(self, run: RunContext) -> None:
+        cfg = run.scenario.humans
+        self.cfg = cfg
+        world = run.service(Warehouse)
+        self.fleet = run.service(FleetState)
+        self.dynamic = run.service(DynamicObstacles)
+        self.graph, stations, docks = _graph(run, world)
+        rng = run.rng.stream("humans/demand")
+        duration_s = run.scenario.scenario.duration_s
+        limits = run.scenario.robots
+        demand: list[Plan] = plans(
+            self.graph,
+            stations,
+            docks,
+            kind="worker",
+            count=cfg.workers,
+            duration_s=duration_s,
+            speed_mps=cfg.worker_speed_mps,
+            stay_s=cfg.pick_s,
+            rng=rng,
+        )
+        demand += plans(
+            self.graph,
+            stations,
+            docks,
+            kind="forklift",
+            count=cfg.forklifts,
+            duration_s=duration_s,
+            speed_mps=cfg.forklift_speed_mps,
+            stay_s=cfg.pick_s,
+            rng=rng,
+        )
+        standing = np.array(cfg.standing, dtype=float).reshape(-1, 2)
+        demand += standing_plans(self.graph, standing, duration_s)
+        self.folder = Path(tempfile.mkdtemp(prefix="cosim-sumo-"))
+        self.step_ns = period_ns(1.0 / cfg.step_length_s)
+        self.seed = int(run.rng.stream("humans/sumo").integers(1, 2**31 - 1))
+        try:
+            lanes = write_network(self.graph, self.folder, forklifts=cfg.forklifts > 0)
+            types = TrafficTypes(
+                worker_width_m=2 * cfg.worker_radius_m,
+                worker_speed_mps=cfg.worker_speed_mps,
+                robot_size_m=2 * limits.radius_m,
+                robot_speed_mps=limits.max_speed_mps,
+                forklift_length_m=cfg.forklift_size_m[0],
+                forklift_width_m=cfg.forklift_size_m[1],
+                forklift_speed_mps=cfg.forklift_speed_mps,
+            )
+            write_demand(self.graph, demand, lanes, types, self.folder)
+            self.config = write_config(
+                self.folder,
+                step_s=self.step_ns / NS_PER_S,
+                seed=self.seed,
+                end_s=duration_s + 1.0,
+            )
+        except BaseException:
+            shutil.rmtree(self.folder, ignore_errors=True)
+            raise
+        self.people = People()
+        self.people.forklift_size_m = cfg.forklift_size_m
+        self.people.worker_radius_m = cfg.worker_radius_m
+        run.provide(self.people)
+        self.records = HumanRecords(run, cfg)
+        self.recorder = run.recorder
+        self.session: SumoSession | None = None
+        self.steps = 0
+        self.coupling_s = 0.0
+
+    def start(self, run: RunContext) -> None:
+        """Start SUMO, mirror the robots into it and step it every ``step_length_s``."""
+        self.session = SumoSession(self.config, seed=self.seed)
+        self.session.add_robots(self.fleet.names, "e0")
+        run.kernel.every(self.step_ns, lambda now: self._step(run, now), stage=Stage.PEOPLE)
+
+    def _step(self, run: RunContext, now_ns: int) -> None:
+        assert self.session is not None
+        began = time.perf_counter()
+        fleet = self.fleet
+        session = self.session
+        session.move_robots(fleet.x, fleet.y, fleet.yaw)
+        session.step(now_ns / NS_PER_S)
+        walkers = session.people()
+        drivers = session.vehicles() if self.cfg.forklifts else None
+        self._publish(walkers, drivers)
+        self.steps += 1
+        self.coupling_s += time.perf_counter() - began
+        self.records.sample(now_ns, self.people, self.dynamic)
+
+    def _publish(self, walkers: Movers, drivers: Movers | None) -> None:
+        cfg = self.cfg
+        people = self.people
+        discs = [np.column_stack([walkers.x_m, walkers.y_m, np.full(len(walkers.names), cfg.worker_radius_m)])]
+        names = list(walkers.names)
+        kinds = ["person"] * len(names)
+        x, y, yaw, speed = [walkers.x_m], [walkers.y_m], [walkers.yaw_rad], [walkers.speed_mps]
+        if drivers is not None and drivers.names:
+            length, width = cfg.forklift_size_m
+            # SUMO's vehicle position is its front; two discs cover the body
+            cx = drivers.x_m - np.cos(drivers.yaw_rad) * length / 2
+            cy = drivers.y_m - np.sin(drivers.yaw_rad) * length / 2
+            radius = float(np.hypot(length / 4, width / 2))
+            for sign in (1.0, -1.0):
+                discs.append(
+                    np.column_stack(
+                        [
+                            cx + sign * np.cos(drivers.yaw_rad) * length / 4,
+                            cy + sign * np.sin(drivers.yaw_rad) * length / 4,
+                            np.full(len(drivers.names), radius),
+                        ]
+                    )
+                )
+                names += drivers.names
+                kinds += ["forklift"] * len(drivers.names)
+            x.append(cx)
+            y.append(cy)
+            yaw.append(drivers.yaw_rad)
+            speed.append(drivers.speed_mps)
+        self.dynamic.update("humans", np.vstack(discs), names, kinds)
+        people.names = list(walkers.names) + (list(drivers.names) if drivers is not None else [])
+        people.kinds = ["person"] * len(walkers.names) + ["forklift"] * (
+            len(people.names) - len(walkers.names)
+        )
+        people.x_m = np.concatenate(x)
+        people.y_m = np.concatenate(y)
+        people.yaw_rad = np.concatenate(yaw)
+        people.speed_mps = np.concatenate(speed)
+
+    def close(self) -> None:
+        """Stop SUMO and keep its files (and log) for the run folder's ``sumo/``."""
+        if self.session is not None:
+            self.session.close()
+        if self.folder.is_dir():
+            for path in sorted(self.folder.iterdir()):
+                if path.suffix in (".xml", ".sumocfg", ".log") and path.stat().st_size > 0:
+                    self.recorder.add_file(f"sumo/{path.name}", path.read_bytes())
+            shutil.rmtree(self.folder, ignore_errors=True)
+
+    def finish(self, run: RunContext) -> Mapping[str, Any]:
+        """People metrics and the coupling's cost."""
+        summary = self.records.summary(run)
+        summary.update(
+            {
+                "humans_workers": self.cfg.workers,
+                "humans_standing": len(self.cfg.standing),
+                "humans_forklifts": self.cfg.forklifts,
+                "humans_sumo_steps": self.steps,
+                "humans_coupling_wall_s": round(self.coupling_s, 4),
+                "humans_sumo_in_process": bool(self.session and self.session.in_process),
+            }
+        )
+        return summary
+
+
+def _graph(run: RunContext, world: Warehouse) -> tuple[AisleGraph, Any, Any]:
+    cfg = run.scenario.humans
+    try:
+        graph = aisle_graph(
+            world,
+            clearance_m=cfg.worker_radius_m + CLEARANCE_MARGIN_M,
+            spacing_m=cfg.aisle_spacing_m,
+        )
+        stations = pick_stations(world, graph, cfg.stations, run.rng.stream("humans/stations"))
+    except ModelError as error:
+        raise ScenarioError(
+            f"{run.scenario.source}: {error.key} = {error.value!r}: expected {error.expected}"
+        ) from None
+    return graph, stations, dock_points(graph)

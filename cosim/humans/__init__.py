@@ -1,0 +1,1 @@
+"""SUMO co-simulation: the files SUMO reads and a running SUMO session."""

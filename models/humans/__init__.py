@@ -1,0 +1,1 @@
+"""People and forklifts in the aisles: the walking graph, demand and encounter metrics."""

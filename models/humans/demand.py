@@ -1,0 +1,133 @@
+"""Demand: what each worker and forklift does during a run (seeded, no SUMO needed).
+
+A worker starts at a dock spot and walks to pick stations drawn at random, staying at
+each for a time drawn from ``pick_s``; after each pick it returns to the dock with
+probability ``DOCK_RETURN`` (dropping off for ``DOCK_STAY_S``). A forklift does the same
+with its own stays. Plans run past the simulation's end; SUMO simply stops there.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from models.humans.aisles import AisleGraph, IntArray
+from models.arrays import FloatArray
+
+DOCK_RETURN = 0.3
+"""Probability that a worker returns to the dock after a pick."""
+DOCK_STAY_S = (5.0, 15.0)
+"""How long a worker or forklift stays at the dock (s)."""
+DEPART_SPREAD_S = 10.0
+"""Departures are spread evenly over this interval from the start (s)."""
+DETOUR = 1.5
+"""Walking distance over straight-line distance assumed when estimating a plan's time."""
+
+
+@dataclass(frozen=True)
+class Spot:
+    """A place on the aisle graph.
+
+    Attributes:
+        edge: edge index in the :class:`AisleGraph`.
+        offset_m: distance from the edge's first node (m).
+    """
+
+    edge: int
+    offset_m: float
+
+
+@dataclass(frozen=True)
+class Stage:
+    """One step of a plan: go to ``spot``, then stay ``stay_s`` seconds (0: walk on)."""
+
+    spot: Spot
+    stay_s: float
+
+
+@dataclass(frozen=True)
+class Plan:
+    """What one person or forklift does.
+
+    Attributes:
+        name: its id (``worker_3``, ``forklift_0``, ``standing_1``).
+        kind: ``worker`` or ``forklift``.
+        depart_s: when it appears (s).
+        start: where it appears.
+        stages: where it goes next, in order.
+    """
+
+    name: str
+    kind: Literal["worker", "forklift"]
+    depart_s: float
+    start: Spot
+    stages: tuple[Stage, ...]
+
+
+def _spots(edges: IntArray, offsets: FloatArray) -> list[Spot]:
+    return [Spot(int(e), float(o)) for e, o in zip(edges, offsets, strict=True)]
+
+
+def plans(
+    graph: AisleGraph,
+    stations: tuple[IntArray, FloatArray],
+    docks: tuple[IntArray, FloatArray],
+    *,
+    kind: Literal["worker", "forklift"],
+    count: int,
+    duration_s: float,
+    speed_mps: float,
+    stay_s: tuple[float, float],
+    rng: np.random.Generator,
+) -> list[Plan]:
+    """Plans for ``count`` workers or forklifts covering ``duration_s``.
+
+    Args:
+        graph: the aisle graph.
+        stations: pick stations (edge indices, offsets m).
+        docks: dock spots (edge indices, offsets m).
+        kind: ``worker`` or ``forklift``.
+        count: how many.
+        duration_s: the run's length (s); plans are made to last longer.
+        speed_mps: travel speed for the time estimate (m/s).
+        stay_s: [min, max] stay at a pick station (s).
+        rng: the demand's random stream.
+    """
+    station_spots = _spots(*stations)
+    dock_spots = _spots(*docks)
+    result = []
+    for k in range(count):
+        start = dock_spots[int(rng.integers(len(dock_spots)))]
+        here = graph.point(start.edge, start.offset_m)
+        elapsed = 0.0
+        stages: list[Stage] = []
+
+        def visit(spot: Spot, stay: float) -> None:
+            nonlocal here, elapsed
+            there = graph.point(spot.edge, spot.offset_m)
+            distance = float(np.hypot(there[0] - here[0], there[1] - here[1]))
+            elapsed += DETOUR * distance / speed_mps + stay
+            stages.append(Stage(spot, round(stay, 1)))
+            here = there
+
+        while elapsed < duration_s + 60.0:
+            visit(station_spots[int(rng.integers(len(station_spots)))], float(rng.uniform(*stay_s)))
+            if rng.random() < DOCK_RETURN:
+                dock = dock_spots[int(rng.integers(len(dock_spots)))]
+                visit(dock, float(rng.uniform(*DOCK_STAY_S)))
+        depart = round(DEPART_SPREAD_S * k / max(count, 1), 1)
+        result.append(Plan(f"{kind}_{k}", kind, depart, start, tuple(stages)))
+    return result
+
+
+def standing_plans(graph: AisleGraph, points: FloatArray, duration_s: float) -> list[Plan]:
+    """Workers who stand, from the start, at the aisle spots nearest ``points`` (n, 2)."""
+    if len(points) == 0:
+        return []
+    edges, offsets, _ = graph.nearest(points)
+    return [
+        Plan(f"standing_{k}", "worker", 0.0, spot, (Stage(spot, duration_s + 60.0),))
+        for k, spot in enumerate(_spots(edges, offsets))
+    ]
