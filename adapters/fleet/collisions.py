@@ -4,8 +4,10 @@ It guards every physics step of the fleet: the proposed poses are checked agains
 shelves, other robots and dynamic obstacles; a robot whose proposed pose overlaps
 anything is held at its last pose with zero velocity ("stopped": it never passes
 through nor jumps). Robots held back may in turn block others, so holding repeats until
-no robot moves into contact. Each new contact is a row in ``tables/collisions`` and an
-event; the smallest clearance over the run and the near misses (clearance below
+no robot moves into contact. Each new contact is a row in ``tables/collisions`` (t_s,
+robot, other, kind = wall | shelf | robot | person | forklift | dynamic, depth_m, and
+speed_mps: the robot's speed in the step that touched; 0 when something moved into a
+robot standing still) and an event; the smallest clearance over the run and the near misses (clearance below
 ``NEAR_MISS_M``) go into the summary.
 """
 
@@ -26,7 +28,7 @@ from models.world import Warehouse
 
 NEAR_MISS_M = 0.1
 """Clearance below which two things count as a near miss (m)."""
-COLLISION_COLUMNS = ("t_s", "robot", "other", "kind", "depth_m")
+COLLISION_COLUMNS = ("t_s", "robot", "other", "kind", "depth_m", "speed_mps")
 
 Pair = tuple[int, int, int]
 """(robot, kind, other) of a pair in contact or near each other."""
@@ -78,6 +80,7 @@ class CollisionsAdapter:
         enough; longer steps re-run the broad phase.
         """
         checker = self.checker
+        proposed_v = motion.v.copy()
         candidates = checker.candidates(motion.x, motion.y, self.dynamic.discs)
         gaps = checker.gaps(candidates, motion.x, motion.y)
         final, least = checker.summarize(gaps)
@@ -103,14 +106,16 @@ class CollisionsAdapter:
             least = min(least, checker.floor(candidates))
         self.min_clearance_m = min(self.min_clearance_m, least)
         near = {(p.robot, p.kind.value, p.other) for p in final}
-        self._record_contacts(now_ns, attempted)
+        self._record_contacts(now_ns, attempted, proposed_v)
         # a contact lasts until the pair is farther apart than the near-miss margin again,
         # so a robot creeping against a wall is one collision, not one per step
         self.contacts &= near
         self.near_misses += len(near - self.near)
         self.near = near
 
-    def _record_contacts(self, now_ns: int, attempted: list[Proximity]) -> None:
+    def _record_contacts(
+        self, now_ns: int, attempted: list[Proximity], proposed_v: np.ndarray
+    ) -> None:
         for p in attempted:
             pair = (p.robot, p.kind.value, p.other)
             if pair in self.contacts:
@@ -119,7 +124,12 @@ class CollisionsAdapter:
             other, kind = self._other(p)
             robot = self.fleet.names[p.robot]
             self.table.append(
-                t_s=now_ns / NS_PER_S, robot=robot, other=other, kind=kind, depth_m=-p.clearance_m
+                t_s=now_ns / NS_PER_S,
+                robot=robot,
+                other=other,
+                kind=kind,
+                depth_m=-p.clearance_m,
+                speed_mps=float(proposed_v[p.robot]),
             )
             self.recorder.event(now_ns, robot, "collision", f"{kind} {other}, robot stopped")
             self.collisions += 1

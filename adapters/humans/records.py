@@ -15,7 +15,7 @@ import numpy as np
 from cosim.adapter import RunContext
 from cosim.scenario.humans import HumansConfig
 from cosim.timebase import NS_PER_S, period_ns
-from models.humans.encounters import Encounters
+from models.humans.encounters import HALT_MPS, Encounters
 from models.kinematics import FleetState
 from models.obstacles import DynamicObstacles
 
@@ -83,15 +83,19 @@ class HumanRecords:
     def summary(self, run: RunContext) -> dict[str, Any]:
         """Minimum distance, near misses, stops and contacts with people."""
         least = self.encounters.min_clearance_m
-        contacts = 0
+        contacts = driving = 0
         table = run.recorder.tables.get("collisions")
         if table is not None and len(table):
             frame = table.frame()
-            contacts = int(frame["kind"].isin(PEOPLE_KINDS).sum())
+            people = frame[frame["kind"].isin(PEOPLE_KINDS)]
+            contacts = len(people)
+            driving = int((people["speed_mps"].abs() >= HALT_MPS).sum())
         return {
             "humans_seen": len(self.seen),
             "humans_min_distance_m": round(least, 4) if np.isfinite(least) else None,
             "humans_near_misses": self.near_misses,
             "humans_robot_stops": self.stops,
             "humans_collisions": contacts,
+            # the robot was driving; the others are people walking into a robot at rest
+            "humans_collisions_robot_moving": driving,
         }

@@ -5,8 +5,11 @@ the run's traffic with ``sumo-gui -c humans.sumocfg`` and see what the robots sa
 
 The network keeps the ``map`` frame (``--offset.disable-normalization``): SUMO's x, y are
 cosim's. Each aisle edge ``e<k>`` is one lane centred on the aisle line, as wide as the
-aisle allows, open to pedestrians and to the robots' mirrors (vClass ``custom1``);
-with forklifts, they (vClass ``custom2``) drive on it and on its reverse twin ``r<k>``.
+aisle allows, open to pedestrians and to the robots' mirrors (vClass ``custom1``); with forklifts,
+they (vClass ``custom2``) drive on it and on its reverse twin ``r<k>``. The twin is open
+to pedestrians too: a lane closed to them would split the junctions' walking areas (SUMO
+lets people cross a road only on a crossing), so with forklifts people walk on either
+twin, and SUMO's people see one another and the robots only on the same twin.
 """
 
 from __future__ import annotations
@@ -95,7 +98,7 @@ def write_network(graph: AisleGraph, folder: Path, *, forklifts: bool) -> dict[s
                 edges,
                 "edge",
                 id=f"r{k}",
-                attrib={"from": f"n{b}", "to": f"n{a}", "allow": FORKLIFT_CLASS},
+                attrib={"from": f"n{b}", "to": f"n{a}", "allow": f"pedestrian {FORKLIFT_CLASS}"},
             ).attrib.update(common)
     _write_xml(nodes, folder / "aisles.nod.xml")
     _write_xml(edges, folder / "aisles.edg.xml")
@@ -107,6 +110,7 @@ def write_network(graph: AisleGraph, folder: Path, *, forklifts: bool) -> dict[s
         "--offset.disable-normalization", "true",
         "--walkingareas", "true",
         "--default.junctions.radius", f"{JUNCTION_RADIUS_M}",
+        "--precision", "3",
         "--no-warnings", "true",
     ]  # fmt: skip
     try:
@@ -122,6 +126,7 @@ def write_network(graph: AisleGraph, folder: Path, *, forklifts: bool) -> dict[s
         raise BridgeError(f"SUMO's netconvert could not build {folder / NETWORK}: {error}") from None
     if done.returncode != 0 or not (folder / NETWORK).is_file():
         lines = [line for line in done.stderr.splitlines() if line.strip()]
+        lines = [line for line in lines if line.startswith("Error")] or lines
         raise BridgeError(
             f"SUMO's netconvert could not build {folder / NETWORK}: "
             f"{lines[-1] if lines else f'exit status {done.returncode}'}"

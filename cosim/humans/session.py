@@ -12,11 +12,12 @@ so nothing SUMO-specific crosses a process boundary.
 
 from __future__ import annotations
 
+import contextlib
+import io
 import math
 import subprocess
 import threading
 from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -32,6 +33,7 @@ from models.arrays import FloatArray
 
 SUMO_ERRORS: tuple[type[BaseException], ...] = (
     libsumo.TraCIException,
+    libsumo.FatalTraCIError,
     traci.TraCIException,
     traci.FatalTraCIError,
 )
@@ -111,7 +113,8 @@ class SumoSession:
                     libsumo.start(command)
                 else:
                     label = f"cosim-{next(_LABELS)}"
-                    traci.start(command, label=label, stdout=subprocess.DEVNULL)
+                    with contextlib.redirect_stdout(io.StringIO()):  # "Retrying in 1 seconds"
+                        traci.start(command, label=label, stdout=subprocess.DEVNULL)
                     self._api = traci.getConnection(label)
         except BaseException:
             if self.in_process:
@@ -123,7 +126,7 @@ class SumoSession:
         self._waiting: dict[tuple[str, float], tuple[float, float]] = {}
         self._robots: list[str] = []
 
-    @contextmanager
+    @contextlib.contextmanager
     def errors(self, doing: str) -> Iterator[None]:
         """Turn SUMO's exceptions inside the block into a BridgeError."""
         try:
@@ -139,7 +142,8 @@ class SumoSession:
         if lines:
             return f"{lines[-1]} (SUMO's log: {self.log})"
         message = getattr(error, "getString", None)
-        return str(message() if callable(message) else error)
+        text = str(message() if callable(message) else error)
+        return " ".join(text.split())
 
     @property
     def time_s(self) -> float:

@@ -1,6 +1,6 @@
 """Demand: what each worker and forklift does during a run (seeded, no SUMO needed).
 
-A worker starts at a dock spot and walks to pick stations drawn at random, staying at
+A worker starts at a pick station and walks to pick stations drawn at random, staying at
 each for a time drawn from ``pick_s``; after each pick it returns to the dock with
 probability ``DOCK_RETURN`` (dropping off for ``DOCK_STAY_S``). A forklift does the same
 with its own stays. Plans run past the simulation's end; SUMO simply stops there.
@@ -99,7 +99,8 @@ def plans(
     dock_spots = _spots(*docks)
     result = []
     for k in range(count):
-        start = dock_spots[int(rng.integers(len(dock_spots)))]
+        # in the aisles already when the run starts (not at the dock where robots wait)
+        start = station_spots[int(rng.integers(len(station_spots)))]
         here = graph.point(start.edge, start.offset_m)
         elapsed = 0.0
         stages: list[Stage] = []
