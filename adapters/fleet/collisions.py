@@ -5,10 +5,10 @@ shelves, other robots and dynamic obstacles; a robot whose proposed pose overlap
 anything is held at its last pose with zero velocity ("stopped": it never passes
 through nor jumps). Robots held back may in turn block others, so holding repeats until
 no robot moves into contact. Each new contact is a row in ``tables/collisions`` (t_s,
-robot, other, kind = wall | shelf | robot | person | forklift | dynamic, depth_m, and
-speed_mps: the robot's speed in the step that touched; 0 when something moved into a
-robot standing still) and an event; the smallest clearance over the run and the near misses (clearance below
-``NEAR_MISS_M``) go into the summary.
+robot, other, kind = wall | shelf | robot | person | forklift | dynamic, depth_m,
+speed_mps: the robot's speed in the step that touched, 0 when something moved into a
+robot at rest) and an event; the smallest clearance over the run and the near misses
+(clearance below ``NEAR_MISS_M``) go into the summary.
 """
 
 from __future__ import annotations

@@ -24,6 +24,7 @@ from __future__ import annotations
 import shutil
 import tempfile
 import time
+import weakref
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, ClassVar
@@ -114,6 +115,8 @@ class HumansAdapter:
         standing = np.array(cfg.standing, dtype=float).reshape(-1, 2)
         demand += standing_plans(self.graph, standing, duration_s)
         self.folder = Path(tempfile.mkdtemp(prefix="cosim-sumo-"))
+        # removed by close(); also when a run is assembled but never started (cosim check)
+        weakref.finalize(self, shutil.rmtree, self.folder, True)
         self.step_ns = period_ns(1.0 / cfg.step_length_s)
         self.seed = int(run.rng.stream("humans/sumo").integers(1, 2**31 - 1))
         try:
@@ -170,7 +173,11 @@ class HumansAdapter:
     def _publish(self, walkers: Movers, drivers: Movers | None) -> None:
         cfg = self.cfg
         people = self.people
-        discs = [np.column_stack([walkers.x_m, walkers.y_m, np.full(len(walkers.names), cfg.worker_radius_m)])]
+        discs = [
+            np.column_stack(
+                [walkers.x_m, walkers.y_m, np.full(len(walkers.names), cfg.worker_radius_m)]
+            )
+        ]
         names = list(walkers.names)
         kinds = ["person"] * len(names)
         x, y, yaw, speed = [walkers.x_m], [walkers.y_m], [walkers.yaw_rad], [walkers.speed_mps]

@@ -123,7 +123,9 @@ def write_network(graph: AisleGraph, folder: Path, *, forklifts: bool) -> dict[s
             check=False,
         )
     except (OSError, subprocess.TimeoutExpired) as error:
-        raise BridgeError(f"SUMO's netconvert could not build {folder / NETWORK}: {error}") from None
+        raise BridgeError(
+            f"SUMO's netconvert could not build {folder / NETWORK}: {error}"
+        ) from None
     if done.returncode != 0 or not (folder / NETWORK).is_file():
         lines = [line for line in done.stderr.splitlines() if line.strip()]
         lines = [line for line in lines if line.startswith("Error")] or lines

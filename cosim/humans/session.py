@@ -200,9 +200,7 @@ class SumoSession:
                 if speed[k] == 0.0 and api.person.getStage(name).type == STAGE_WAITING:
                     # SUMO draws a person who stays somewhere 3 m beside the lane; they
                     # stand on it
-                    x[k], y[k] = self._on_lane(
-                        values[tc.VAR_ROAD_ID], values[tc.VAR_LANEPOSITION]
-                    )
+                    x[k], y[k] = self._on_lane(values[tc.VAR_ROAD_ID], values[tc.VAR_LANEPOSITION])
         return Movers(names, x, y, yaw_of_angle(angle), speed)
 
     def _on_lane(self, edge: str, position: float) -> tuple[float, float]:

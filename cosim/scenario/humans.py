@@ -27,7 +27,8 @@ class HumansConfig:
         "aisle) for the whole run",
     )
     near_miss_m: float = param(
-        0.5, "a robot and a person closer than this (footprint to footprint) is a near miss (m)",
+        0.5,
+        "a robot and a person closer than this (footprint to footprint) is a near miss (m)",
         gt=0,
     )
     step_length_s: float = param(

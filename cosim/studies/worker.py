@@ -19,8 +19,15 @@ from cosim.runner import execute
 from cosim.scenario import load_scenario
 from cosim.scenario.loader import dump_scenario
 
-VOLATILE_METRICS = ("wall_time_s", "real_time_factor", "python", "version")
-"""Summary entries that depend on the machine, not on the scenario and seed."""
+VOLATILE_METRICS = (
+    "wall_time_s",
+    "real_time_factor",
+    "python",
+    "version",
+    "humans_coupling_wall_s",
+    "humans_sumo_in_process",
+)
+"""Summary entries that depend on the machine or executor, not on the scenario and seed."""
 
 
 @dataclass(frozen=True)

@@ -11,6 +11,7 @@ aisle is one edge and its junctions are where cross-aisles meet it.
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -138,7 +139,7 @@ def _lines(extents: FloatArray, size: float, clearance: float, spacing: float) -
     # open stretches (and the borders of the room) get evenly spaced lines too
     bounds = [clearance, *lines, size - clearance]
     filled: list[float] = []
-    for lo, hi in zip(bounds[:-1], bounds[1:], strict=True):
+    for lo, hi in itertools.pairwise(bounds):
         parts = int((hi - lo) // (FILL_FACTOR * spacing))
         filled.extend(np.linspace(lo, hi, parts + 2)[1:-1].tolist() if parts > 0 else [])
     return np.array(sorted(lines + filled), dtype=float)
@@ -165,9 +166,7 @@ def _segment_clearance(
     return least
 
 
-def _largest_part(
-    count: int, pairs: IntArray, least: FloatArray
-) -> tuple[IntArray, FloatArray]:
+def _largest_part(count: int, pairs: IntArray, least: FloatArray) -> tuple[IntArray, FloatArray]:
     adjacency = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), (count, count))
     _, labels = connected_components(adjacency, directed=False)
     sizes = np.bincount(labels[pairs[:, 0]], minlength=labels.max() + 1)
@@ -190,7 +189,7 @@ def _merge_chains(
             return False
         (a, _), (b, _) = links
         da, db = grid[a] - grid[node], grid[b] - grid[node]
-        return abs(da[0] * db[1] - da[1] * db[0]) < 1e-9
+        return bool(abs(da[0] * db[1] - da[1] * db[0]) < 1e-9)
 
     kept = sorted(n for n in neighbours if not straight(n))
     merged: dict[tuple[int, int], float] = {}

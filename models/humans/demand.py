@@ -13,14 +13,14 @@ from typing import Literal
 
 import numpy as np
 
-from models.humans.aisles import AisleGraph, IntArray
 from models.arrays import FloatArray
+from models.humans.aisles import AisleGraph, IntArray
 
 DOCK_RETURN = 0.3
 """Probability that a worker returns to the dock after a pick."""
 DOCK_STAY_S = (5.0, 15.0)
 """How long a worker or forklift stays at the dock (s)."""
-DEPART_SPREAD_S = 10.0
+DEPART_SPREAD_S = 1.0
 """Departures are spread evenly over this interval from the start (s)."""
 DETOUR = 1.5
 """Walking distance over straight-line distance assumed when estimating a plan's time."""
@@ -101,26 +101,38 @@ def plans(
     for k in range(count):
         # in the aisles already when the run starts (not at the dock where robots wait)
         start = station_spots[int(rng.integers(len(station_spots)))]
-        here = graph.point(start.edge, start.offset_m)
-        elapsed = 0.0
-        stages: list[Stage] = []
+        stages = _stages(
+            graph, start, station_spots, dock_spots, duration_s, speed_mps, stay_s, rng
+        )
+        depart = round(DEPART_SPREAD_S * k / max(count, 1), 1)
+        result.append(Plan(f"{kind}_{k}", kind, depart, start, stages))
+    return result
 
-        def visit(spot: Spot, stay: float) -> None:
-            nonlocal here, elapsed
+
+def _stages(
+    graph: AisleGraph,
+    start: Spot,
+    stations: list[Spot],
+    docks: list[Spot],
+    duration_s: float,
+    speed_mps: float,
+    stay_s: tuple[float, float],
+    rng: np.random.Generator,
+) -> tuple[Stage, ...]:
+    here = graph.point(start.edge, start.offset_m)
+    elapsed = 0.0
+    stages: list[Stage] = []
+    while elapsed < duration_s + 60.0:
+        visits = [(stations[int(rng.integers(len(stations)))], float(rng.uniform(*stay_s)))]
+        if rng.random() < DOCK_RETURN:
+            visits.append((docks[int(rng.integers(len(docks)))], float(rng.uniform(*DOCK_STAY_S))))
+        for spot, stay in visits:
             there = graph.point(spot.edge, spot.offset_m)
             distance = float(np.hypot(there[0] - here[0], there[1] - here[1]))
             elapsed += DETOUR * distance / speed_mps + stay
             stages.append(Stage(spot, round(stay, 1)))
             here = there
-
-        while elapsed < duration_s + 60.0:
-            visit(station_spots[int(rng.integers(len(station_spots)))], float(rng.uniform(*stay_s)))
-            if rng.random() < DOCK_RETURN:
-                dock = dock_spots[int(rng.integers(len(dock_spots)))]
-                visit(dock, float(rng.uniform(*DOCK_STAY_S)))
-        depart = round(DEPART_SPREAD_S * k / max(count, 1), 1)
-        result.append(Plan(f"{kind}_{k}", kind, depart, start, tuple(stages)))
-    return result
+    return tuple(stages)
 
 
 def standing_plans(graph: AisleGraph, points: FloatArray, duration_s: float) -> list[Plan]:

@@ -27,9 +27,18 @@ NEEDS = {
         "physical.pose": "odom",
         "physical.dds_domain": 171,
     },
+    "humans": {"humans.workers": 3},
 }
 """Scenario keys an adapter needs to have something to do."""
-VOLATILE = {"wall_time_s", "real_time_factor", "max_lateness_ms", "p99_lateness_ms", "late_batches"}
+VOLATILE = {
+    "wall_time_s",
+    "real_time_factor",
+    "max_lateness_ms",
+    "p99_lateness_ms",
+    "late_batches",
+    "humans_coupling_wall_s",  # wall clock spent in SUMO
+    "humans_sumo_in_process",  # libsumo here, or SUMO in a child process: same tables
+}
 
 
 def test_the_registry_holds_the_core_adapters():

@@ -67,5 +67,5 @@ def test_netconvert_refusing_the_network_reports_its_own_error_line(tmp_path):
 def test_a_file_that_is_not_a_network_is_refused_naming_it(tmp_path):
     bad = tmp_path / "bad.net.xml"
     bad.write_text("<net>garbage")
-    with pytest.raises(BridgeError, match="bad.net.xml: not a readable SUMO network"):
+    with pytest.raises(BridgeError, match=r"bad\.net\.xml: not a readable SUMO network"):
         lane_lengths(bad)

@@ -31,7 +31,7 @@ def _same(a, b):
 def test_people_and_forklifts_move_and_the_same_seed_repeats_them_exactly(sumo_files):
     in_process, first = _trajectories(sumo_files)
     assert in_process
-    names, x, _, vehicles = first[-1]
+    names, _, _, vehicles = first[-1]
     assert len(names) == 6 and sorted(vehicles) == ["forklift_0", "forklift_1"]
     assert not np.allclose(first[10][1], first[-1][1])  # they walked
     _same(first, _trajectories(sumo_files)[1])
@@ -71,9 +71,11 @@ def test_a_demand_sumo_refuses_is_one_line_with_sumos_reason_and_frees_libsumo(s
 def test_a_missing_person_is_a_bridge_error_not_a_libsumo_exception(sumo_files):
     session = SumoSession(sumo_files, seed=1)
     try:
-        with pytest.raises(BridgeError, match="SUMO failed to read"):
-            with session.errors("read a person"):
-                session._api.person.getPosition("nobody")
+        with (
+            pytest.raises(BridgeError, match="SUMO failed to read"),
+            session.errors("read a person"),
+        ):
+            session._api.person.getPosition("nobody")
     finally:
         session.close()
 
