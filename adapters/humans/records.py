@@ -12,12 +12,14 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from adapters.tasks.source import TaskSourceAdapter
 from cosim.adapter import RunContext
 from cosim.scenario.humans import HumansConfig
 from cosim.timebase import NS_PER_S, period_ns
 from models.humans.encounters import HALT_MPS, Encounters
 from models.kinematics import FleetState
 from models.obstacles import DynamicObstacles
+from models.tasks.book import TaskStatus
 
 if TYPE_CHECKING:
     from adapters.humans.traffic import People
@@ -40,6 +42,8 @@ class HumanRecords:
         self.stops = 0
         self.robot_stops = np.zeros(len(self.fleet), dtype=np.int64)
         self.seen: set[str] = set()
+        self.met: dict[str, list[int]] = {name: [] for name in self.fleet.names}
+        """Per robot, the instants of its near misses and stops caused by people (ns)."""
 
     def sample(self, now_ns: int, people: People, dynamic: DynamicObstacles) -> None:
         """Take the people at ``now_ns`` into the table and the metrics."""
@@ -65,6 +69,8 @@ class HumanRecords:
         began, stops = self.encounters.update(
             robots, fleet.v, discs[mine], [names[k] for k in mine]
         )
+        for e in began + stops:
+            self.met[fleet.names[e.robot]].append(now_ns)
         for e in began:
             self.near_misses += 1
             self.recorder.event(
@@ -80,6 +86,33 @@ class HumanRecords:
                 f"{e.person} at {e.clearance_m:.2f} m",
             )
 
+    def _task_latencies(self, run: RunContext) -> dict[str, Any]:
+        """Mean task latency (creation to completion, s) with and without people on the way.
+
+        A task met people when its robot had a near miss or a stop caused by people between
+        the task's assignment and its completion.
+        """
+        if not run.has_service(TaskSourceAdapter):
+            return {}
+        met: list[float] = []
+        clear: list[float] = []
+        for task in run.service(TaskSourceAdapter).book.tasks.values():
+            if task.status is not TaskStatus.DONE or not task.server:
+                continue
+            latency = (task.completed_ns - task.created_ns) / NS_PER_S
+            times = self.met.get(task.server, [])
+            hit = any(task.assigned_ns <= t <= task.completed_ns for t in times)
+            (met if hit else clear).append(latency)
+
+        def mean(values: list[float]) -> float | None:
+            return round(float(np.mean(values)), 6) if values else None
+
+        return {
+            "humans_tasks_met_people": len(met),
+            "humans_task_latency_met_people_s": mean(met),
+            "humans_task_latency_clear_s": mean(clear),
+        }
+
     def summary(self, run: RunContext) -> dict[str, Any]:
         """Minimum distance, near misses, stops and contacts with people."""
         least = self.encounters.min_clearance_m
@@ -91,6 +124,7 @@ class HumanRecords:
             contacts = len(people)
             driving = int((people["speed_mps"].abs() >= HALT_MPS).sum())
         return {
+            **self._task_latencies(run),
             "humans_seen": len(self.seen),
             "humans_min_distance_m": round(least, 4) if np.isfinite(least) else None,
             "humans_near_misses": self.near_misses,

@@ -161,6 +161,10 @@ def test_two_runs_with_one_seed_are_identical_and_another_seed_moves_people_else
     )
     humans = a.tables["humans"]
     assert set(humans["id"]) == {f"worker_{k}" for k in range(10)}
+    summary = a.summary
+    assert summary["humans_tasks_met_people"] <= summary["tasks_completed"]
+    for key in ("humans_task_latency_met_people_s", "humans_task_latency_clear_s"):
+        assert summary[key] is None or 0 < summary[key] <= 20.0
     c = run(_small(), seed=2)
     assert not c.tables["humans"][["x_m", "y_m"]].equals(humans[["x_m", "y_m"]])
 
