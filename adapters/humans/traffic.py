@@ -8,7 +8,8 @@ config) and keeps them for the run folder's ``sumo/``.
 ``PEOPLE`` stage (after the robots' physics step of that instant, before any sensor):
 
 1. the robots' mirrors in SUMO are placed at the robots' true poses at t_k;
-2. SUMO advances from t_(k-1) to t_k, its people reacting to the mirrors as placed;
+2. SUMO advances from t_(k-1) to t_k (its clock equals the kernel's after every step;
+   people appear from t_1 = Δ on), its people reacting to the mirrors as placed;
 3. people and forklifts at t_k become the run's dynamic obstacles, seen by every lidar
    and collision check until t_(k+1) (sample and hold).
 
@@ -154,7 +155,13 @@ class HumansAdapter:
         """Start SUMO, mirror the robots into it and step it every ``step_length_s``."""
         self.session = SumoSession(self.config, seed=self.seed)
         self.session.add_robots(self.fleet.names, "e0")
-        run.kernel.every(self.step_ns, lambda now: self._step(run, now), stage=Stage.PEOPLE)
+        # SUMO starts at 0 with nobody inserted yet; its first step brings it to Δ
+        run.kernel.every(
+            self.step_ns,
+            lambda now: self._step(run, now),
+            stage=Stage.PEOPLE,
+            start_ns=self.step_ns,
+        )
 
     def _step(self, run: RunContext, now_ns: int) -> None:
         assert self.session is not None

@@ -176,6 +176,7 @@ def test_the_humans_table_has_its_contract_columns_and_people_stay_in_the_aisles
     assert set(humans["kind"]) == {"person"}
     assert humans["speed_mps"].between(0, 2.0).all()
     assert humans["x_m"].between(0, 30).all() and humans["y_m"].between(0, 30).all()
+    assert humans["t_s"].min() == pytest.approx(0.1)  # SUMO's first step
     per_step = humans.groupby("t_s").size()
     assert per_step.max() <= 10
     assert np.allclose(np.diff(per_step.index.to_numpy()), 0.1)
@@ -200,7 +201,7 @@ def test_the_run_folder_holds_sumo_files_that_sumo_itself_loads(tmp_path):
     )
     assert done.returncode == 0, done.stderr
     assert (tmp_path / "run" / "tables" / "humans.parquet").is_file()
-    assert result.summary["humans_sumo_steps"] == 200
+    assert result.summary["humans_sumo_steps"] == 199  # 0.1 s ... 19.9 s (the run ends at 20 s)
 
 
 def test_two_runs_at_once_in_one_process_both_work_and_agree():

@@ -13,6 +13,7 @@ def _trajectories(config, steps=200):
         seen = []
         for k in range(1, steps + 1):
             session.step(k * 0.1)
+            assert session.time_s == pytest.approx(k * 0.1)  # lockstep: no lookahead
             people, vehicles = session.people(), session.vehicles()
             seen.append((people.names, people.x_m.copy(), people.y_m.copy(), vehicles.names))
         return session.in_process, seen
