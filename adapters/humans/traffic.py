@@ -46,6 +46,7 @@ from cosim.kernel import Stage
 from cosim.timebase import NS_PER_S, period_ns
 from models.errors import ModelError
 from models.humans.aisles import AisleGraph, aisle_graph, dock_points, pick_stations
+from models.humans.bodies import two_disc_cover, vehicle_centres
 from models.humans.demand import Plan, plans, standing_plans
 from models.kinematics import FleetState
 from models.obstacles import DynamicObstacles
@@ -190,22 +191,10 @@ class HumansAdapter:
         x, y, yaw, speed = [walkers.x_m], [walkers.y_m], [walkers.yaw_rad], [walkers.speed_mps]
         if drivers is not None and drivers.names:
             length, width = cfg.forklift_size_m
-            # SUMO's vehicle position is its front; two discs cover the body
-            cx = drivers.x_m - np.cos(drivers.yaw_rad) * length / 2
-            cy = drivers.y_m - np.sin(drivers.yaw_rad) * length / 2
-            radius = float(np.hypot(length / 4, width / 2))
-            for sign in (1.0, -1.0):
-                discs.append(
-                    np.column_stack(
-                        [
-                            cx + sign * np.cos(drivers.yaw_rad) * length / 4,
-                            cy + sign * np.sin(drivers.yaw_rad) * length / 4,
-                            np.full(len(drivers.names), radius),
-                        ]
-                    )
-                )
-                names += drivers.names
-                kinds += ["forklift"] * len(drivers.names)
+            cx, cy = vehicle_centres(drivers.x_m, drivers.y_m, drivers.yaw_rad, length)
+            discs.append(two_disc_cover(cx, cy, drivers.yaw_rad, length, width))
+            names += list(drivers.names) * 2
+            kinds += ["forklift"] * (2 * len(drivers.names))
             x.append(cx)
             y.append(cy)
             yaw.append(drivers.yaw_rad)
