@@ -3,6 +3,7 @@
 import math
 import re
 import subprocess
+import sys
 import threading
 from collections.abc import Mapping
 from typing import Any, ClassVar
@@ -237,3 +238,17 @@ def test_a_room_too_narrow_for_people_is_one_line_and_exit_status_2(capsys):
     assert status == 2
     assert "humans.worker_radius_m" in err and "Traceback" not in err
     assert len(err.strip().splitlines()) == 1
+
+
+def test_a_missing_libsumo_is_one_line_naming_it_and_exit_status_2():
+    code = (
+        "import sys; sys.modules['libsumo'] = None\n"
+        "from cosim.cli import main\n"
+        "sys.exit(main(['run', 'warehouse-humans', '--duration-s', '1', '--bag', 'none']))\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=False
+    )
+    assert done.returncode == 2
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and "libsumo" in lines[0] and "humans" in lines[0]
