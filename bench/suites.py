@@ -10,6 +10,7 @@ from typing import Any, ClassVar
 import numpy as np
 from assignment_bench import assignment_solve_stats
 from dwa_bench import dwa_us_per_robot
+from humans_bench import humans_coupling
 from lidar_bench import lidar_rays_per_second
 from mapping_bench import aces_mapping, fleet50_mapping, per_scan_costs
 from network_bench import network_deliveries_per_second
@@ -340,4 +341,5 @@ SUITES: dict[str, Callable[[int], Result]] = {
     "mapping_per_scan": per_scan_costs,
     "fleet50_mapping": fleet50_mapping,
     "aces_mapping": aces_mapping,
+    "humans_coupling": humans_coupling,
 }

@@ -43,6 +43,10 @@ STAGE_WAITING = 1
 PERSON_VARS = (tc.VAR_POSITION, tc.VAR_ANGLE, tc.VAR_SPEED, tc.VAR_ROAD_ID, tc.VAR_LANEPOSITION)
 VEHICLE_VARS = (tc.VAR_POSITION, tc.VAR_ANGLE, tc.VAR_SPEED)
 
+MATCH_THRESHOLD_M = 4.0
+"""How far from a robot SUMO first looks for a lane to put its mirror on (m): the search
+costs in proportion (SUMO's default, 100 m, is the fallback)."""
+
 _LIBSUMO = threading.Lock()
 """Held by the session that runs in this process through libsumo."""
 _LABELS = iter(range(1 << 62))
@@ -162,12 +166,18 @@ class SumoSession:
 
     def move_robots(self, x_m: FloatArray, y_m: FloatArray, yaw_rad: FloatArray) -> None:
         """Place the robots' mirrors at their poses (``map``) before the next step."""
+        # every step, also a robot at rest: a mirror left alone drives on along the lane it
+        # was put on and leaves SUMO at the lane's end
         move = self._api.vehicle.moveToXY
         with self.errors("move the robots"):
             for name, x, y, yaw in zip(
                 self._robots, x_m.tolist(), y_m.tolist(), yaw_rad.tolist(), strict=True
             ):
-                move(name, "", -1, x, y, angle_of_yaw(yaw), keepRoute=2)
+                angle = angle_of_yaw(yaw)
+                try:
+                    move(name, "", -1, x, y, angle, 2, MATCH_THRESHOLD_M)
+                except SUMO_ERRORS:  # no lane that close: look as far as SUMO does
+                    move(name, "", -1, x, y, angle, 2)
 
     def step(self, until_s: float) -> None:
         """Advance SUMO to ``until_s`` (s) and subscribe to whoever appeared."""

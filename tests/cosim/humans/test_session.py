@@ -88,3 +88,19 @@ def test_sumo_headings_and_yaw_convert_both_ways(yaw):
 
 def test_sumo_north_is_yaw_pi_over_two():
     assert yaw_of_angle(np.array([0.0, 90.0]))[:] == pytest.approx([np.pi / 2, 0.0])
+
+
+def test_a_robot_far_from_every_lane_is_still_mirrored_where_it_is(sumo_files):
+    session = SumoSession(sumo_files, seed=1)
+    try:
+        session.add_robots(["robot_1", "robot_2"], "e0")
+        x, y = np.array([-6.0, 15.0]), np.array([5.0, 2.0])  # 6 m outside the hall; an aisle
+        for k in range(1, 40):  # placed every step: a mirror left alone would drive off
+            session.move_robots(x, y, np.array([0.0, np.pi / 2]))
+            session.step(k * 0.1)
+        for i, name in enumerate(["robot_1", "robot_2"]):
+            px, py = session._api.vehicle.getPosition(name)
+            assert (px, py) == pytest.approx((x[i], y[i]), abs=0.05)
+        assert not {"robot_1", "robot_2"} & set(session.vehicles().names)  # not forklifts
+    finally:
+        session.close()
