@@ -11,7 +11,7 @@ STUDY = $(BIN)/cosim study studies/$(1).toml --out $(STUDIES)/$(1) --resume
 
 .PHONY: setup demo test lint bench clean help reproduce study-comm study-comm-reduced \
 	study-burst study-scale study-paper study-nav study-mapping study-mapping-reduced map-aces \
-	lab-real lab-mixed
+	lab-real lab-mixed study-humans study-humans-reduced
 
 help:  ## list the targets
 	@grep -E '^[a-z-]+:.*##' $(MAKEFILE_LIST) | sed 's/:.*## /\t/'
@@ -38,12 +38,13 @@ lint: setup  ## ruff and mypy --strict
 bench: setup  ## benchmarks -> bench/results.json
 	$(BIN)/python bench/run.py --out bench/results.json
 
-reproduce: setup  ## Scenarios 1-3, a reduced comm sweep and map sharing (about 8 min on 2 cores)
+reproduce: setup  ## Scenarios 1-3, reduced comm sweep, map sharing and people (about 8 min on 2 cores)
 	$(call STUDY,paper)
 	$(call STUDY,comm_sweep_reduced)
 	$(call STUDY,map_sharing_reduced)
+	$(call STUDY,humans_reduced)
 	$(MAKE) --no-print-directory lab-real lab-mixed
-	@echo "reports: $(STUDIES)/paper/report.md $(STUDIES)/comm_sweep_reduced/report.md $(STUDIES)/map_sharing_reduced/report.md"
+	@echo "reports: $(STUDIES)/paper/report.md $(STUDIES)/comm_sweep_reduced/report.md $(STUDIES)/map_sharing_reduced/report.md $(STUDIES)/humans_reduced/report.md"
 	@echo "mixed reality: runs/lab-real-in-virtual/figures runs/lab-mixed/figures"
 
 lab-real: setup  ## Scenario 2: a stand-in physical robot through goals among virtual obstacles (1 min, real time)
@@ -72,6 +73,12 @@ study-mapping: setup  ## map sharing: bandwidth x loss x share mode, 5 seeds x 3
 
 study-mapping-reduced: setup  ## map sharing reduced to 12 runs x 120 s
 	$(call STUDY,map_sharing_reduced)
+
+study-humans: setup  ## robots among 0-20 SUMO-driven workers, 5 seeds x 300 s (about 3 min)
+	$(call STUDY,humans)
+
+study-humans-reduced: setup  ## robots among 0 or 10 workers, 2 seeds x 60 s
+	$(call STUDY,humans_reduced)
 
 ACES ?= ../shared/data/aces_lidar
 map-aces: setup  ## map the ACES building's recording (needs ../shared/data) into runs/aces

@@ -11,7 +11,9 @@ config) and keeps them for the run folder's ``sumo/``.
 2. SUMO advances from t_(k-1) to t_k (its clock equals the kernel's after every step;
    people appear from t_1 = Δ on), its people reacting to the mirrors as placed;
 3. people and forklifts at t_k become the run's dynamic obstacles, seen by every lidar
-   and collision check until t_(k+1) (sample and hold).
+   and collision check until t_(k+1) (sample and hold). A person SUMO put reaching into a
+   shelf (its lane runs along the shelf's face) is first moved out until it touches it
+   (``humans_pushed_out`` counts these samples).
 
 There is no lookahead: SUMO never runs ahead of the kernel. People react to robots with
 a delay of up to one step; between steps cosim holds a person where SUMO put them at
@@ -27,6 +29,7 @@ import tempfile
 import time
 import weakref
 from collections.abc import Mapping
+from dataclasses import replace
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -46,7 +49,7 @@ from cosim.kernel import Stage
 from cosim.timebase import NS_PER_S, period_ns
 from models.errors import ModelError
 from models.humans.aisles import AisleGraph, aisle_graph, dock_points, pick_stations
-from models.humans.bodies import two_disc_cover, vehicle_centres
+from models.humans.bodies import push_out, two_disc_cover, vehicle_centres
 from models.humans.demand import Plan, plans, standing_plans
 from models.kinematics import FleetState
 from models.obstacles import DynamicObstacles
@@ -122,7 +125,12 @@ class HumansAdapter:
         self.step_ns = period_ns(1.0 / cfg.step_length_s)
         self.seed = int(run.rng.stream("humans/sumo").integers(1, 2**31 - 1))
         try:
-            lanes = write_network(self.graph, self.folder, forklifts=cfg.forklifts > 0)
+            lanes = write_network(
+                self.graph,
+                self.folder,
+                forklifts=cfg.forklifts > 0,
+                inset_m=2 * cfg.worker_radius_m,
+            )
             types = TrafficTypes(
                 worker_width_m=2 * cfg.worker_radius_m,
                 worker_speed_mps=cfg.worker_speed_mps,
@@ -151,6 +159,9 @@ class HumansAdapter:
         self.session: SumoSession | None = None
         self.steps = 0
         self.coupling_s = 0.0
+        self.boxes = world.boxes
+        self.pushed = 0
+        """Person samples SUMO put reaching into a shelf or wall, moved out (see push_out)."""
 
     def start(self, run: RunContext) -> None:
         """Start SUMO, mirror the robots into it and step it every ``step_length_s``."""
@@ -181,11 +192,12 @@ class HumansAdapter:
     def _publish(self, walkers: Movers, drivers: Movers | None) -> None:
         cfg = self.cfg
         people = self.people
-        discs = [
-            np.column_stack(
-                [walkers.x_m, walkers.y_m, np.full(len(walkers.names), cfg.worker_radius_m)]
-            )
-        ]
+        xy, pushed = push_out(
+            np.column_stack([walkers.x_m, walkers.y_m]), cfg.worker_radius_m, self.boxes
+        )
+        self.pushed += pushed
+        walkers = replace(walkers, x_m=xy[:, 0], y_m=xy[:, 1])
+        discs = [np.column_stack([xy, np.full(len(walkers.names), cfg.worker_radius_m)])]
         names = list(walkers.names)
         kinds = ["person"] * len(names)
         x, y, yaw, speed = [walkers.x_m], [walkers.y_m], [walkers.yaw_rad], [walkers.speed_mps]
@@ -228,6 +240,7 @@ class HumansAdapter:
                 "humans_standing": len(self.cfg.standing),
                 "humans_forklifts": self.cfg.forklifts,
                 "humans_sumo_steps": self.steps,
+                "humans_pushed_out": self.pushed,
                 "humans_coupling_wall_s": round(self.coupling_s, 4),
                 "humans_sumo_in_process": bool(self.session and self.session.in_process),
             }

@@ -8,8 +8,10 @@ cosim's. Each aisle edge ``e<k>`` is one lane centred on the aisle line, as wide
 aisle allows, open to pedestrians and to the robots' mirrors (vClass ``custom1``); with forklifts,
 they (vClass ``custom2``) drive on it and on its reverse twin ``r<k>``. The twin is open
 to pedestrians too: a lane closed to them would split the junctions' walking areas (SUMO
-lets people cross a road only on a crossing), so with forklifts people walk on either
-twin, and SUMO's people see one another and the robots only on the same twin.
+lets people cross a road only on a crossing). netconvert lays the twins side by side,
+each right of the line, so with forklifts each twin is half the aisle wide: like traffic
+on a road, forklifts keep right; people walk on either half and SUMO's people see one
+another and the robots only on the same half.
 """
 
 from __future__ import annotations
@@ -29,6 +31,8 @@ ROUTES = "humans.rou.xml"
 CONFIG = "humans.sumocfg"
 ROBOT_CLASS = "custom1"
 FORKLIFT_CLASS = "custom2"
+MIN_LANE_M = 0.3
+"""Narrowest lane written, however tight the aisle (m)."""
 JUNCTION_RADIUS_M = 0.3
 """Corner radius of junctions: aisles meet at right angles, nobody needs a wide turn (m)."""
 NETCONVERT_TIMEOUT_S = 120.0
@@ -70,8 +74,18 @@ def sumo_tool(name: str) -> Path:
     return Path(found)
 
 
-def write_network(graph: AisleGraph, folder: Path, *, forklifts: bool) -> dict[str, float]:
+def write_network(
+    graph: AisleGraph, folder: Path, *, forklifts: bool, inset_m: float = 0.0
+) -> dict[str, float]:
     """Write the plain network and convert it to ``aisles.net.xml`` with netconvert.
+
+    Args:
+        graph: the aisle graph; an edge's lane is its ``width_m`` less ``inset_m``.
+        folder: where the files go.
+        forklifts: add the reverse twins forklifts need.
+        inset_m: how much narrower than the free aisle a lane is (m): SUMO puts a
+            pedestrian's centre anywhere up to the lane's edge, so a lane narrower by a
+            person's width keeps people off the shelves' faces.
 
     Returns:
         The length of each lane by edge id (m): junctions take a little of every edge,
@@ -89,7 +103,11 @@ def write_network(graph: AisleGraph, folder: Path, *, forklifts: bool) -> dict[s
     for k, ((a, b), width) in enumerate(
         zip(graph.edges.tolist(), graph.width_m.tolist(), strict=True)
     ):
-        common = {"numLanes": "1", "width": f"{width:.3f}", "spreadType": "center"}
+        # netconvert lays two opposite edges side by side, each right of the line: with
+        # forklifts, each takes half the aisle
+        lane = max(width - inset_m, MIN_LANE_M)
+        lane = lane / 2 if forklifts else lane
+        common = {"numLanes": "1", "width": f"{lane:.3f}", "spreadType": "center"}
         ET.SubElement(
             edges, "edge", id=f"e{k}", attrib={"from": f"n{a}", "to": f"n{b}", "allow": forward}
         ).attrib.update(common)

@@ -21,6 +21,7 @@ from PIL import Image
 from cosim.errors import ExportError
 from cosim.plotting.canvas import Color, fleet_colors
 from cosim.plotting.fleet import FleetLayer, fleet_handles
+from cosim.plotting.people import FORKLIFT_COLOR, PERSON_COLOR, PeopleLayer, people_handles
 from cosim.plotting.rays import LidarRays
 from cosim.plotting.rundata import RunData
 from cosim.plotting.world import (
@@ -82,6 +83,7 @@ def animation_gif(
     ax = figure.add_subplot()
     draw_world(ax, run.warehouse, shelf_color=SHELF_MUTED)
     layer = FleetLayer(ax, run, colors, label_robots=False)  # unreadable at GIF resolution
+    people = PeopleLayer(ax, run)
     rays = LidarRays(run, lidar_robot, max_rays=90)
     beams = LineCollection([], colors=RAY_COLOR, linewidths=0.4, alpha=0.5, zorder=2)
     ax.add_collection(beams)
@@ -93,19 +95,29 @@ def animation_gif(
     lidar = Line2D([], [], color=RAY_COLOR, lw=0.8, label=f"lidar, {track.robots[lidar_robot]}")
     handles = [
         *fleet_handles(run, colors),
+        *people_handles(run),
         lidar,
         *world_handles(run.warehouse, shelf_color=SHELF_MUTED),
     ]
     figure.legend(handles=handles, loc="outside right upper", fontsize=8)
 
-    moving = [beams, hits, *layer.show(indices[0]), clock]
+    moving = [beams, hits, *people.show(float(track.t_s[indices[0]])), *layer.show(indices[0])]
+    moving.append(clock)
     for artist in moving:
         artist.set_animated(True)
     # matplotlib leaves these Agg canvas methods unannotated
     canvas.draw()  # type: ignore[no-untyped-call]  # the world, axes, legend; once
     canvas.draw()  # type: ignore[no-untyped-call]  # again: the layout settles
     background = canvas.copy_from_bbox(figure.bbox)  # type: ignore[no-untyped-call]
-    inks: list[Color | str] = [*colors, RAY_COLOR, SHELF_MUTED, OBSTACLE_COLOR, *INKS]
+    inks: list[Color | str] = [
+        *colors,
+        RAY_COLOR,
+        SHELF_MUTED,
+        OBSTACLE_COLOR,
+        PERSON_COLOR,
+        FORKLIFT_COLOR,
+        *INKS,
+    ]
     palette = _palette(inks, robots=len(colors))
     frames = []  # indexed at once: a quarter of the memory of RGB frames
     for i in indices:
@@ -114,7 +126,8 @@ def animation_gif(
         beams.set_segments([np.array([origin, end]) for end in ends])
         hits.set_offsets(ends[hit] if hit.any() else np.zeros((0, 2)))
         clock.set_text(f"t = {track.t_s[i]:5.1f} s   ({speedup:g}x real time)")
-        for artist in [beams, hits, *layer.show(i), clock]:  # in z order
+        people_now = people.show(float(track.t_s[i]))
+        for artist in [beams, hits, *people_now, *layer.show(i), clock]:  # in z order
             ax.draw_artist(artist)
         pixels = np.asarray(canvas.buffer_rgba())  # type: ignore[no-untyped-call]
         rgb = Image.fromarray(pixels).convert("RGB")

@@ -38,9 +38,10 @@ TASK_COLUMNS = (
 MESSAGE_COLUMNS = ("t_sent_s", "t_recv_s", "src_host", "dst_host", "topic", "status")
 ASSIGNMENT_COLUMNS = ("epoch", "t_s", "robot", "round", "converged", "messages")
 NAVIGATION_COLUMNS = ("t_s", "robot", "event", "goal_x_m", "goal_y_m")
+HUMAN_COLUMNS = ("t_s", "id", "kind", "x_m", "y_m", "yaw_rad")
 STATION_TOLERANCE_M = 1e-6
 """A navigation goal this close to a task station is a goal to that station (m)."""
-_NAMES = ("robot", "src_host", "dst_host", "topic", "status", "event")
+_NAMES = ("robot", "src_host", "dst_host", "topic", "status", "event", "id", "kind")
 """Columns of names (categorical in the tables), read as plain strings."""
 
 
@@ -89,6 +90,7 @@ class RunData:
             ``""``; None when the run has no such table or it has no row.
         messages: ``tables/messages``, or None likewise.
         assignments: ``tables/assignments``, or None likewise.
+        humans: ``tables/humans`` (people and forklifts moved by SUMO), or None likewise.
     """
 
     path: Path
@@ -98,6 +100,7 @@ class RunData:
     tasks: pd.DataFrame | None
     messages: pd.DataFrame | None
     assignments: pd.DataFrame | None
+    humans: pd.DataFrame | None = None
 
     @property
     def title(self) -> str:
@@ -134,6 +137,7 @@ def load_run(run_dir: Path) -> RunData:
         tasks=_tasks(run_dir),
         messages=_optional(run_dir, "messages", MESSAGE_COLUMNS),
         assignments=_optional(run_dir, "assignments", ASSIGNMENT_COLUMNS),
+        humans=_optional(run_dir, "humans", HUMAN_COLUMNS),
     )
 
 

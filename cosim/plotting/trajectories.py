@@ -13,6 +13,7 @@ from matplotlib.lines import Line2D
 
 from cosim.plotting.canvas import LEGEND_ROBOTS_MAX, Color, fleet_colors, save_png
 from cosim.plotting.fleet import TRAIL_S, WAITING_COLOR, FleetLayer, TaskTimes, fleet_handles
+from cosim.plotting.people import PeopleLayer, draw_tracks, people_handles
 from cosim.plotting.rundata import RunData
 from cosim.plotting.world import SHELF_MUTED, draw_world, world_handles, world_inches
 
@@ -30,7 +31,8 @@ def trajectories_figure(run: RunData, png_path: Path) -> Path:
     """Draw every robot's trajectory over the world to ``png_path``.
 
     A colour per robot, its start as a square, its final pose as a disc with a heading tick
-    (frame ``map``, m); with tasks, every task station as a diamond filled with the colour
+    (frame ``map``, m); people and forklifts as thin tracks and at their final place; with
+    tasks, every task station as a diamond filled with the colour
     of the robot that completed it (white: not completed), labelled with its task numbers.
 
     Raises:
@@ -42,6 +44,7 @@ def trajectories_figure(run: RunData, png_path: Path) -> Path:
     figure = Figure(figsize=(width + LEGEND_IN + 0.8, height + 0.8), layout="constrained")
     ax = figure.add_subplot()
     draw_world(ax, run.warehouse, shelf_color=SHELF_MUTED)
+    draw_tracks(ax, run)
     line_width = 1.3 if len(track.robots) <= LEGEND_ROBOTS_MAX else 0.7
     for r, color in enumerate(colors):
         ax.plot(track.x_m[:, r], track.y_m[:, r], color=color, lw=line_width, alpha=0.85)
@@ -50,6 +53,7 @@ def trajectories_figure(run: RunData, png_path: Path) -> Path:
             x0, y0 = track.x_m[start[0], r], track.y_m[start[0], r]
             ax.plot(x0, y0, marker="s", ms=6, mfc="none", mec=color, mew=1.3, zorder=4)
     FleetLayer(ax, run, colors, trail_s=0.0, tasks=False).show(len(track.t_s) - 1)
+    PeopleLayer(ax, run).show(float(track.t_s[-1]))
     _stations(ax, run, colors)
     ax.set_title(
         f"{run.title}: trajectories, t = {track.t_s[0]:g} to {track.t_s[-1]:g} s", fontsize=10
@@ -57,6 +61,7 @@ def trajectories_figure(run: RunData, png_path: Path) -> Path:
     handles = [
         *_robot_lines(run, colors),
         *_marks(run),
+        *people_handles(run),
         *world_handles(run.warehouse, shelf_color=SHELF_MUTED),
     ]
     figure.legend(handles=handles, loc="outside right upper", fontsize=8)
@@ -68,7 +73,8 @@ def snapshots_figure(run: RunData, times_s: Sequence[float], png_path: Path) -> 
 
     Each panel: the world, every robot as a disc with a heading tick at the pose sample
     nearest the time, its trail over the last :data:`~cosim.plotting.fleet.TRAIL_S`, and the
-    open tasks (filled with the holder's colour, a dashed line to it). Panels wrap after 3
+    open tasks (filled with the holder's colour, a dashed line to it), and the people and
+    forklifts at that time. Panels wrap after 3
     (2 for 4 times); times are expected within the run (checked by the caller).
 
     Raises:
@@ -92,6 +98,7 @@ def snapshots_figure(run: RunData, times_s: Sequence[float], png_path: Path) -> 
         draw_world(ax, run.warehouse, shelf_color=SHELF_MUTED, labels=False)
         i = track.index_at(t)
         FleetLayer(ax, run, colors).show(i)
+        PeopleLayer(ax, run).show(float(track.t_s[i]))
         ax.set_title(f"t = {track.t_s[i]:.1f} s", fontsize=10)
         if k % cols == 0:
             ax.set_ylabel("y (m, map)")
@@ -99,7 +106,11 @@ def snapshots_figure(run: RunData, times_s: Sequence[float], png_path: Path) -> 
             ax.set_xlabel("x (m, map)")
             ax.xaxis.set_tick_params(labelbottom=True)
     figure.suptitle(f"{run.title}: snapshots, trails of the last {TRAIL_S:g} s", fontsize=11)
-    handles = [*fleet_handles(run, colors), *world_handles(run.warehouse, shelf_color=SHELF_MUTED)]
+    handles = [
+        *fleet_handles(run, colors),
+        *people_handles(run),
+        *world_handles(run.warehouse, shelf_color=SHELF_MUTED),
+    ]
     # beside the first row's last panel: a figure legend would run into the title
     panels[min(cols, count) - 1].legend(
         handles=handles, loc="upper left", bbox_to_anchor=(1.03, 1.0), fontsize=8
