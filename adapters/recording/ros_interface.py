@@ -14,7 +14,10 @@ publishes the same on the bus, so a bag or the live view of a run opens in those
 - ``/map`` (nav_msgs/OccupancyGrid of the walls and shelves, latched);
 - ``/world/markers`` (visualization_msgs/MarkerArray, latched): walls, shelves, robot
   footprints riding on their ``base_link``, and the open tasks (orange, green once held),
-  re-published whole whenever the open tasks or their holders change.
+  re-published whole whenever the open tasks or their holders change;
+- ``/humans/markers`` (visualization_msgs/MarkerArray) in runs with people: every worker
+  (orange cylinder, 1.7 m) and forklift (yellow box) where SUMO put them, a DELETEALL and
+  the whole crowd per sample, a marker id per person for the run.
 
 It samples on the pose recorder's tick and watches ``/fleet/tasks`` with a bus monitor,
 so it adds no kernel event, no delivery and no table row: a run's tables are the same
@@ -30,6 +33,7 @@ import numpy as np
 
 from adapters.assignment.topics import TASKS
 from adapters.fleet.motion import FleetAdapter
+from adapters.humans.traffic import People
 from adapters.naming import topic
 from adapters.recording.poses import PosesAdapter
 from cosim.adapter import RunContext
@@ -69,6 +73,11 @@ TF = "/tf"
 TF_STATIC = "/tf_static"
 MAP = "/map"
 MARKERS = "/world/markers"
+HUMAN_MARKERS = "/humans/markers"
+PERSON_RGBA: RGBA = (0.95, 0.56, 0.17, 0.9)
+FORKLIFT_RGBA: RGBA = (0.93, 0.79, 0.28, 0.9)
+PERSON_HEIGHT_M = 1.7
+FORKLIFT_HEIGHT_M = 2.0
 
 
 class RosInterfaceAdapter:
@@ -95,6 +104,10 @@ class RosInterfaceAdapter:
         bus.advertise(MARKERS, MarkerArray, TopicQos.LATCHED)
         for name in self.truth_topics:
             bus.advertise(name, Odometry)
+        self.people = run.service(People) if run.has_service(People) else None
+        self.person_ids: dict[str, int] = {}
+        if self.people is not None:
+            bus.advertise(HUMAN_MARKERS, MarkerArray)
         run.service(PosesAdapter).on_sample(lambda now: self._sample(run, now))
 
     def start(self, run: RunContext) -> None:
@@ -232,6 +245,42 @@ class RosInterfaceAdapter:
             truth = Odometry(now_ns, "map", base_link, xi, yi, yawi, vi, wi)
             bus.publish(self.truth_topics[i], truth, BASE_HOST)
         bus.publish(TF, TFMessage(now_ns, tuple(transforms)), BASE_HOST)
+        if self.people is not None:
+            bus.publish(HUMAN_MARKERS, self._people_markers(now_ns, self.people), BASE_HOST)
+
+    def _people_markers(self, now_ns: int, people: People) -> MarkerArray:
+        markers = [Marker("humans", 0, MarkerType.CYLINDER, action=MarkerAction.DELETEALL)]
+        diameter = 2 * people.worker_radius_m
+        length, width = people.forklift_size_m
+        rows = zip(
+            people.names,
+            people.kinds,
+            people.x_m.tolist(),
+            people.y_m.tolist(),
+            people.yaw_rad.tolist(),
+            strict=True,
+        )
+        for name, kind, x, y, yaw in rows:
+            marker_id = self.person_ids.setdefault(name, len(self.person_ids))
+            if kind == "forklift":
+                shape = (MarkerType.CUBE, (length, width, FORKLIFT_HEIGHT_M), FORKLIFT_RGBA)
+            else:
+                shape = (MarkerType.CYLINDER, (diameter, diameter, PERSON_HEIGHT_M), PERSON_RGBA)
+            kind_of, scale, rgba = shape
+            markers.append(
+                Marker(
+                    "humans",
+                    marker_id,
+                    kind_of,
+                    x_m=x,
+                    y_m=y,
+                    z_m=scale[2] / 2,
+                    yaw_rad=yaw,
+                    scale_m=scale,
+                    color=rgba,
+                )
+            )
+        return MarkerArray(now_ns, tuple(markers))
 
     def finish(self, run: RunContext) -> Mapping[str, Any]:
         """Nothing to add to the summary."""

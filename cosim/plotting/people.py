@@ -1,6 +1,6 @@
 """People and forklifts (``tables/humans``) drawn over the world (frame ``map``, m).
 
-Workers are orange discs of ``humans.worker_radius_m``; forklifts yellow rectangles of
+Workers are near-black discs of ``humans.worker_radius_m``; forklifts yellow rectangles of
 ``humans.forklift_size_m`` turned to their heading. A snapshot shows everyone at the
 latest sample at or before its time; the trajectories figure shows their tracks thin.
 """
@@ -17,8 +17,9 @@ from matplotlib.patches import Circle, Patch, Polygon
 
 from cosim.plotting.rundata import RunData
 
-PERSON_COLOR = "#f28e2b"
-"""Workers: orange (people stand out from the robots' greens and the greys of shelves)."""
+PERSON_COLOR = "#1c1c1c"
+"""Workers: near-black discs with a white rim, unlike any robot's colour (robots take
+Tableau's or turbo's colours, physical twins red and virtual robots green)."""
 FORKLIFT_COLOR = "#edc948"
 """Forklifts: yellow, as painted."""
 TRACK_ALPHA = 0.35
@@ -45,7 +46,7 @@ class PeopleLayer:
         self.radius_m = cfg.worker_radius_m
         self.size_m = cfg.forklift_size_m
         self.people = PatchCollection(
-            [], facecolor=PERSON_COLOR, edgecolor="0.15", linewidths=0.5, zorder=5
+            [], facecolor=PERSON_COLOR, edgecolor="white", linewidths=0.8, zorder=5
         )
         self.forklifts = PatchCollection(
             [], facecolor=FORKLIFT_COLOR, edgecolor="0.15", linewidths=0.6, zorder=5
@@ -117,7 +118,7 @@ def people_handles(run: RunData) -> list[Line2D]:
                 color=PERSON_COLOR,
                 marker="o",
                 ls="none",
-                mec="0.15",
+                mec="white",
                 label=f"{people} people (SUMO)",
             )
         )

@@ -133,3 +133,37 @@ def test_a_taken_port_is_one_line_and_exit_2_before_anything_is_written(tmp_path
     assert stderr.count("\n") == 1 and f"--live-port {port}" in stderr
     assert "Traceback" not in stderr
     assert sorted(p.name for p in out.iterdir()) == ["keep.txt"]
+
+
+def test_a_viewer_sees_the_people_sumo_moves_as_markers(tmp_path):
+    port = _free_port()
+    command = [
+        sys.executable, "-m", "cosim", "run", "warehouse-humans", "--set", "humans.workers=4",
+        "--duration-s", "20", "--out", str(tmp_path / "run"), "--bag", "none",
+        "--live", "--live-port", str(port), "--live-rate", "4", "--live-wait",
+    ]  # fmt: skip
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        with _connect(port, process) as ws:
+            channels = _channels(ws)
+            while "/humans/markers" not in channels:
+                frame = ws.recv(timeout=30)
+                if isinstance(frame, str) and json.loads(frame)["op"] == "advertise":
+                    channels.update({c["topic"]: c for c in json.loads(frame)["channels"]})
+            people = channels["/humans/markers"]
+            assert people["schemaName"] == "visualization_msgs/msg/MarkerArray"
+            ws.send(
+                json.dumps(
+                    {"op": "subscribe", "subscriptions": [{"id": 9, "channelId": people["id"]}]}
+                )
+            )
+            shown = []
+            while len(shown) < 4:  # nobody before SUMO's first step
+                _, payload = _next_data(ws, 9)
+                message = typestore().deserialize_cdr(payload, "visualization_msgs/msg/MarkerArray")
+                shown = [m for m in message.markers if m.action == 0]
+            assert {m.ns for m in shown} == {"humans"}
+            assert all(m.header.frame_id == "map" for m in shown)
+    finally:
+        process.terminate()
+        process.communicate(timeout=30)
