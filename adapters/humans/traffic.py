@@ -146,6 +146,9 @@ class HumansAdapter:
                 step_s=self.step_ns / NS_PER_S,
                 seed=self.seed,
                 end_s=duration_s + 1.0,
+                # a stripe per person's width: two people pass each other in a 1.1 m lane
+                stripe_width_m=2 * cfg.worker_radius_m,
+                jam_time_s=cfg.jam_time_s,
             )
         except BaseException:
             shutil.rmtree(self.folder, ignore_errors=True)

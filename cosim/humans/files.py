@@ -288,8 +288,29 @@ def _forklift(routes: ET.Element, graph: AisleGraph, plan: Plan, lanes: dict[str
         )
 
 
-def write_config(folder: Path, *, step_s: float, seed: int, end_s: float) -> Path:
-    """Write ``humans.sumocfg`` naming the network and demand; return its path."""
+def write_config(
+    folder: Path,
+    *,
+    step_s: float,
+    seed: int,
+    end_s: float,
+    stripe_width_m: float = 0.65,
+    jam_time_s: float = 300.0,
+) -> Path:
+    """Write ``humans.sumocfg``: network, demand and every option that shapes the run.
+
+    Args:
+        folder: where the network and demand are.
+        step_s: SUMO's step (s).
+        seed: SUMO's random seed.
+        end_s: when SUMO stops (s).
+        stripe_width_m: the striping model's lateral stripe (m; SUMO's default 0.65).
+        jam_time_s: a pedestrian blocked this long walks on regardless (s; SUMO's 300).
+
+    Returns:
+        The config's path: ``sumo-gui -c`` on it replays the run's people, given the
+        robots' positions (which only the co-simulation has).
+    """
     config = ET.Element("configuration")
     inputs = ET.SubElement(config, "input")
     ET.SubElement(inputs, "net-file", value=NETWORK)
@@ -298,6 +319,10 @@ def write_config(folder: Path, *, step_s: float, seed: int, end_s: float) -> Pat
     ET.SubElement(timing, "begin", value="0")
     ET.SubElement(timing, "end", value=f"{end_s:g}")
     ET.SubElement(timing, "step-length", value=f"{step_s:g}")
+    processing = ET.SubElement(config, "processing")
+    ET.SubElement(processing, "time-to-teleport", value="-1")
+    ET.SubElement(processing, "pedestrian.striping.stripe-width", value=f"{stripe_width_m:g}")
+    ET.SubElement(processing, "pedestrian.striping.jamtime", value=f"{jam_time_s:g}")
     random = ET.SubElement(config, "random_number")
     ET.SubElement(random, "seed", value=str(seed))
     _write_xml(config, folder / CONFIG)

@@ -105,7 +105,6 @@ class SumoSession:
             "--no-warnings", "true",
             "--no-step-log", "true",
             "--duration-log.disable", "true",
-            "--time-to-teleport", "-1",
             *extra,
         ]  # fmt: skip
         self.in_process = _LIBSUMO.acquire(blocking=False)

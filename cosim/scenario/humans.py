@@ -58,6 +58,12 @@ class HumansConfig:
         "people (m)",
         gt=0,
     )
+    jam_time_s: float = param(
+        30.0,
+        "a worker blocked this long squeezes past whoever blocks them (SUMO's "
+        "pedestrian.striping.jamtime; SUMO's default, 300 s, is for streets) (s)",
+        gt=0,
+    )
     record_hz: float = param(
         10.0, "rows per second and person in tables/humans (capped by the SUMO step)", gt=0
     )
