@@ -31,7 +31,7 @@ import weakref
 from collections.abc import Mapping
 from dataclasses import replace
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 
@@ -47,8 +47,9 @@ from cosim.humans.files import (
 from cosim.humans.session import Movers, SumoSession
 from cosim.kernel import Stage
 from cosim.timebase import NS_PER_S, period_ns
+from models.arrays import FloatArray
 from models.errors import ModelError
-from models.humans.aisles import AisleGraph, aisle_graph, dock_points, pick_stations
+from models.humans.aisles import AisleGraph, IntArray, aisle_graph, dock_points, pick_stations
 from models.humans.bodies import push_out, two_disc_cover, vehicle_centres
 from models.humans.demand import Plan, plans, standing_plans
 from models.kinematics import FleetState
@@ -92,33 +93,9 @@ class HumansAdapter:
         self.fleet = run.service(FleetState)
         self.dynamic = run.service(DynamicObstacles)
         self.graph, stations, docks = _graph(run, world)
-        rng = run.rng.stream("humans/demand")
-        duration_s = run.scenario.scenario.duration_s
+        demand = _demand(run, self.graph, stations, docks)
         limits = run.scenario.robots
-        demand: list[Plan] = plans(
-            self.graph,
-            stations,
-            docks,
-            kind="worker",
-            count=cfg.workers,
-            duration_s=duration_s,
-            speed_mps=cfg.worker_speed_mps,
-            stay_s=cfg.pick_s,
-            rng=rng,
-        )
-        demand += plans(
-            self.graph,
-            stations,
-            docks,
-            kind="forklift",
-            count=cfg.forklifts,
-            duration_s=duration_s,
-            speed_mps=cfg.forklift_speed_mps,
-            stay_s=cfg.pick_s,
-            rng=rng,
-        )
-        standing = np.array(cfg.standing, dtype=float).reshape(-1, 2)
-        demand += standing_plans(self.graph, standing, duration_s)
+        duration_s = run.scenario.scenario.duration_s
         self.folder = Path(tempfile.mkdtemp(prefix="cosim-sumo-"))
         # removed by close(); also when a run is assembled but never started (cosim check)
         weakref.finalize(self, shutil.rmtree, self.folder, True)
@@ -251,7 +228,37 @@ class HumansAdapter:
         return summary
 
 
-def _graph(run: RunContext, world: Warehouse) -> tuple[AisleGraph, Any, Any]:
+Spots = tuple[IntArray, FloatArray]
+"""Places on the aisle graph: edge indices and offsets along them (m)."""
+
+
+def _demand(run: RunContext, graph: AisleGraph, stations: Spots, docks: Spots) -> list[Plan]:
+    """Every worker's, forklift's and standing worker's plan, from ``humans/demand``."""
+    cfg = run.scenario.humans
+    rng = run.rng.stream("humans/demand")
+    duration_s = run.scenario.scenario.duration_s
+    demand: list[Plan] = []
+    movers: tuple[tuple[Literal["worker", "forklift"], int, float], ...] = (
+        ("worker", cfg.workers, cfg.worker_speed_mps),
+        ("forklift", cfg.forklifts, cfg.forklift_speed_mps),
+    )
+    for kind, count, speed in movers:
+        demand += plans(
+            graph,
+            stations,
+            docks,
+            kind=kind,
+            count=count,
+            duration_s=duration_s,
+            speed_mps=speed,
+            stay_s=cfg.pick_s,
+            rng=rng,
+        )
+    standing = np.array(cfg.standing, dtype=float).reshape(-1, 2)
+    return demand + standing_plans(graph, standing, duration_s)
+
+
+def _graph(run: RunContext, world: Warehouse) -> tuple[AisleGraph, Spots, Spots]:
     cfg = run.scenario.humans
     try:
         graph = aisle_graph(
