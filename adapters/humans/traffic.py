@@ -13,7 +13,10 @@ config) and keeps them for the run folder's ``sumo/``.
 3. people and forklifts at t_k become the run's dynamic obstacles, seen by every lidar
    and collision check until t_(k+1) (sample and hold). A person SUMO put reaching into a
    shelf (its lane runs along the shelf's face) is first moved out until it touches it
-   (``humans_pushed_out`` counts these samples).
+   (``humans_pushed_out`` counts these samples);
+4. a walker with a robot in the way stops in SUMO until the way is clear, for at most
+   ``humans.yield_s`` (:mod:`models.humans.yielding`; ``humans_yields`` counts them):
+   SUMO's own pedestrians only give way to a vehicle ahead on their lane.
 
 There is no lookahead: SUMO never runs ahead of the kernel. People react to robots with
 a delay of up to one step; between steps cosim holds a person where SUMO put them at
@@ -46,12 +49,13 @@ from cosim.humans.files import (
 )
 from cosim.humans.session import Movers, SumoSession
 from cosim.kernel import Stage
-from cosim.timebase import NS_PER_S, period_ns
+from cosim.timebase import NS_PER_S, period_ns, s_to_ns
 from models.arrays import FloatArray
 from models.errors import ModelError
 from models.humans.aisles import AisleGraph, IntArray, aisle_graph, dock_points, pick_stations
 from models.humans.bodies import push_out, two_disc_cover, vehicle_centres
 from models.humans.demand import Plan, plans, standing_plans
+from models.humans.yielding import Yielding, robots_ahead
 from models.kinematics import FleetState
 from models.obstacles import DynamicObstacles
 from models.world import Warehouse
@@ -139,6 +143,7 @@ class HumansAdapter:
         self.session: SumoSession | None = None
         self.steps = 0
         self.coupling_s = 0.0
+        self.yielding = Yielding(s_to_ns(cfg.yield_s))
         self.boxes = world.boxes
         self.pushed = 0
         """Person samples SUMO put reaching into a shelf or wall, moved out (see push_out)."""
@@ -165,6 +170,8 @@ class HumansAdapter:
         walkers = session.people()
         drivers = session.vehicles() if self.cfg.forklifts else None
         self._publish(walkers, drivers)
+        if self.cfg.yield_s > 0:
+            self._give_way(now_ns, session)
         self.steps += 1
         self.coupling_s += time.perf_counter() - began
         self.records.sample(now_ns, self.people, self.dynamic)
@@ -201,6 +208,32 @@ class HumansAdapter:
         people.yaw_rad = np.concatenate(yaw)
         people.speed_mps = np.concatenate(speed)
 
+    def _give_way(self, now_ns: int, session: SumoSession) -> None:
+        """Stop walkers with a robot in their way; let them go when clear or tired of it."""
+        people = self.people
+        walkers = [k for k, kind in enumerate(people.kinds) if kind == "person"]
+        fleet = self.fleet
+        discs = np.column_stack(
+            [
+                people.x_m[walkers],
+                people.y_m[walkers],
+                np.full(len(walkers), self.cfg.worker_radius_m),
+            ]
+        )
+        blocked = robots_ahead(
+            discs,
+            people.yaw_rad[walkers],
+            self.cfg.worker_speed_mps,
+            np.column_stack([fleet.x, fleet.y, fleet.radius_m]),
+        )
+        names = [people.names[k] for k in walkers]
+        walking = people.speed_mps[walkers] > 0.0
+        stop, go = self.yielding.update(now_ns, names, blocked, walking)
+        if go:
+            session.release(go)
+        if stop:
+            session.hold(stop)
+
     def close(self) -> None:
         """Stop SUMO and keep its files (and log) for the run folder's ``sumo/``."""
         if self.session is not None:
@@ -221,6 +254,7 @@ class HumansAdapter:
                 "humans_forklifts": self.cfg.forklifts,
                 "humans_sumo_steps": self.steps,
                 "humans_pushed_out": self.pushed,
+                "humans_yields": self.yielding.yields,
                 "humans_coupling_wall_s": round(self.coupling_s, 4),
                 "humans_sumo_in_process": bool(self.session and self.session.in_process),
             }

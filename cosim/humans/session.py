@@ -128,6 +128,7 @@ class SumoSession:
         self._vehicles: set[str] = set()
         self._waiting: dict[tuple[str, float], tuple[float, float]] = {}
         self._robots: list[str] = []
+        self._held: dict[str, float] = {}
 
     @contextlib.contextmanager
     def errors(self, doing: str) -> Iterator[None]:
@@ -177,6 +178,24 @@ class SumoSession:
                     move(name, "", -1, x, y, angle, 2, MATCH_THRESHOLD_M)
                 except SUMO_ERRORS:  # no lane that close: look as far as SUMO does
                     move(name, "", -1, x, y, angle, 2)
+
+    def hold(self, names: Sequence[str]) -> None:
+        """Stop these walkers where they are (their walking speed kept for :meth:`release`)."""
+        person = self._api.person
+        with self.errors("stop a person"):
+            for name in names:
+                self._held[name] = float(person.getMaxSpeed(name))
+                person.setSpeed(name, 0.0)
+
+    def release(self, names: Sequence[str]) -> None:
+        """Let walkers stopped by :meth:`hold` walk on at their own speed."""
+        person = self._api.person
+        present = set(person.getIDList())
+        with self.errors("let a person walk on"):
+            for name in names:
+                speed = self._held.pop(name, None)
+                if speed is not None and name in present:
+                    person.setSpeed(name, speed)
 
     def step(self, until_s: float) -> None:
         """Advance SUMO to ``until_s`` (s) and subscribe to whoever appeared."""

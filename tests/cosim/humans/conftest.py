@@ -25,6 +25,16 @@ def warehouse(preset="warehouse-rows"):
 @pytest.fixture
 def sumo_files(tmp_path):
     """A rows warehouse with 6 workers and 2 forklifts written as SUMO files; the config."""
+    return write_files(tmp_path, forklifts=2)
+
+
+@pytest.fixture
+def walkers_only(tmp_path):
+    """The same warehouse with 6 workers and no forklift."""
+    return write_files(tmp_path, forklifts=0)
+
+
+def write_files(tmp_path, *, forklifts):
     world = warehouse()
     graph = aisle_graph(world, clearance_m=0.35, spacing_m=1.5)
     stations = pick_stations(world, graph, 12, np.random.default_rng(2))
@@ -32,7 +42,9 @@ def sumo_files(tmp_path):
     rng = np.random.default_rng(3)
     common = {"duration_s": 60.0, "stay_s": (5.0, 10.0), "rng": rng}
     demand = plans(graph, stations, docks, kind="worker", count=6, speed_mps=1.2, **common)
-    demand += plans(graph, stations, docks, kind="forklift", count=2, speed_mps=2.2, **common)
-    lanes = write_network(graph, tmp_path, forklifts=True)
+    demand += plans(
+        graph, stations, docks, kind="forklift", count=forklifts, speed_mps=2.2, **common
+    )
+    lanes = write_network(graph, tmp_path, forklifts=forklifts > 0, inset_m=0.5)
     write_demand(graph, demand, lanes, TYPES, tmp_path)
-    return write_config(tmp_path, step_s=0.1, seed=5, end_s=61.0)
+    return write_config(tmp_path, step_s=0.1, seed=5, end_s=61.0, stripe_width_m=0.5)

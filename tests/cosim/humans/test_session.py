@@ -104,3 +104,32 @@ def test_a_robot_far_from_every_lane_is_still_mirrored_where_it_is(sumo_files):
         assert not {"robot_1", "robot_2"} & set(session.vehicles().names)  # not forklifts
     finally:
         session.close()
+
+
+def test_a_held_walker_stands_still_and_walks_on_at_their_own_speed_when_released(
+    walkers_only,
+):
+    session = SumoSession(walkers_only, seed=1)
+    try:
+        for k in range(1, 60):
+            session.step(k * 0.1)
+        people = session.people()
+        k_walking = int(np.argmax(people.speed_mps))
+        name = people.names[k_walking]
+        assert people.speed_mps[k_walking] > 0.5
+        own = session._api.person.getMaxSpeed(name)
+        session.hold([name])
+        for k in range(60, 90):
+            session.step(k * 0.1)
+        held = session.people()
+        at = held.names.index(name)
+        assert held.speed_mps[at] == 0.0
+        session.release([name])
+        assert session._api.person.getMaxSpeed(name) == pytest.approx(own)
+        speeds = []
+        for k in range(90, 100):
+            session.step(k * 0.1)
+            speeds.append(session._api.person.getSpeed(name))
+        assert max(speeds) > 0.5, speeds
+    finally:
+        session.close()
