@@ -21,6 +21,7 @@ name = "people"
 scenario = "warehouse-humans"
 seeds = 2
 duration_s = 8.0
+tables = ["humans"]  # only the runs with people have it
 
 [grid]
 "humans.workers" = [0, 6]
@@ -73,6 +74,9 @@ def test_a_study_over_worker_counts_gives_the_same_rows_locally_and_on_a_threade
     with_people = local[local["humans.workers"] == 6]
     assert (with_people["humans_seen"] == 6).all()
     assert local[local["humans.workers"] == 0]["humans_seen"].isna().all()  # SUMO not started
+    for run_id, workers in zip(local["run_id"], local["humans.workers"], strict=True):
+        kept = tmp_path / "local" / "runs" / run_id / "tables" / "humans.parquet"
+        assert kept.is_file() == (workers == 6)
     address, procs = _threaded_dask_worker(tmp_path)
     try:
         from distributed import Client
