@@ -78,34 +78,85 @@ def _allowed(box: FloatArray, spec: WarehouseSpec, keepout: tuple[FloatArray, Fl
     return not (len(squares) and np.any(box_gaps(squares, box) < 0))
 
 
+def _band_slots(
+    spec: WarehouseSpec, band: tuple[float, float], ymin: float, ymax: float
+) -> list[list[float]]:
+    """Shelves in one x band: racks of ``shelves_per_rack`` along x, rows along y.
+
+    A band too narrow for a whole rack gets shorter racks (as many shelves as fit), and one
+    too narrow for a single shelf lengthwise gets the shelves turned (one per rack, their
+    length along y), as a rack generator sized to the room would.
+    """
+    length, depth = spec.shelf_size_m
+    aisle = spec.aisle_width_m
+    bx0, bx1 = band
+    per_rack = min(spec.shelves_per_rack, int((bx1 - bx0 + 1e-9) // length))
+    sx, sy = length, depth
+    if per_rack < 1:  # turned: the shelf's depth along x
+        per_rack, sx, sy = 1, depth, length
+    rack = per_rack * sx
+    rows = int((ymax - ymin + aisle + 1e-9) // (sy + aisle))
+    cols = int((bx1 - bx0 + aisle + 1e-9) // (rack + aisle))
+    if cols < 1 or rows < 1:
+        return []
+    used_x = cols * rack + (cols - 1) * aisle
+    used_y = rows * sy + (rows - 1) * aisle
+    x_start = bx0 + (bx1 - bx0 - used_x) / 2
+    y_start = ymin + (ymax - ymin - used_y) / 2
+    slots = []
+    for row in range(rows):
+        y0 = y_start + row * (sy + aisle)
+        for col in range(cols):
+            for i in range(per_rack):
+                x0 = x_start + col * (rack + aisle) + i * sx
+                slots.append([x0, y0, x0 + sx, y0 + sy])
+    return slots
+
+
 def _rack_shelves(
     spec: WarehouseSpec, region: tuple[float, float, float, float], bands: list[tuple[float, float]]
 ) -> FloatArray:
-    """Shelves in racks of ``shelves_per_rack`` along x, rows of racks along y, per x band."""
-    length, depth = spec.shelf_size_m
-    aisle = spec.aisle_width_m
-    k = spec.shelves_per_rack
-    rack = k * length
+    """Shelves in racks along x, rows of racks along y, per x band (see :func:`_band_slots`)."""
     _, ymin, _, ymax = region
-    rows = int((ymax - ymin + aisle) // (depth + aisle))
-    slots: list[list[float]] = []
-    for bx0, bx1 in bands:
-        cols = int((bx1 - bx0 + aisle) // (rack + aisle))
-        if cols < 1 or rows < 1:
-            continue
-        used_x = cols * rack + (cols - 1) * aisle
-        used_y = rows * depth + (rows - 1) * aisle
-        x_start = bx0 + (bx1 - bx0 - used_x) / 2
-        y_start = ymin + (ymax - ymin - used_y) / 2
-        for row in range(rows):
-            y0 = y_start + row * (depth + aisle)
-            for col in range(cols):
-                for i in range(k):
-                    x0 = x_start + col * (rack + aisle) + i * length
-                    slots.append([x0, y0, x0 + length, y0 + depth])
+    slots = [slot for band in bands for slot in _band_slots(spec, band, ymin, ymax)]
     boxes = np.array(slots, dtype=float).reshape(-1, 4)
     # fill whole rows from the north (far from the dock) across every band first
     return boxes[np.lexsort((boxes[:, 0], -boxes[:, 1]))]
+
+
+def _corridor_bands(
+    spec: WarehouseSpec, xmin: float, xmax: float
+) -> list[list[tuple[float, float]]]:
+    """Ways to lay three shelf bands between two north-south main corridors.
+
+    Corridors two aisles wide first, then one aisle wide (room for longer racks); only
+    ways whose bands are at least a shelf's depth wide.
+
+    Raises:
+        ModelError: on ``world.size_m`` when even one-aisle corridors leave no band a shelf
+            fits in, naming the narrowest room that would do.
+    """
+    aisle = spec.aisle_width_m
+    narrow = min(spec.shelf_size_m)
+    ways = []
+    for corridor in (2 * aisle, aisle):
+        third = (xmax - xmin - 2 * corridor) / 3
+        if third >= narrow:
+            ways.append(
+                [
+                    (xmin + i * (third + corridor), xmin + i * (third + corridor) + third)
+                    for i in range(3)
+                ]
+            )
+    if ways:
+        return ways
+    least = 3 * narrow + 4 * aisle
+    raise ModelError(
+        "world.size_m",
+        list(spec.size_m),
+        f"a room at least {least:.2f} m wide for layout 'two_corridors' (three bands of "
+        f"{narrow:g} m shelves, two corridors and the side aisles of {aisle:g} m)",
+    )
 
 
 def _random_shelves(
@@ -177,16 +228,16 @@ def place_shelves(spec: WarehouseSpec, dock: float, rng: np.random.Generator) ->
     if spec.layout == "random":
         return _random_shelves(spec, region, rng, keepout)
     xmin, _, xmax, _ = region
-    if spec.layout == "all_rows":
-        bands = [(xmin, xmax)]
-    else:  # two_corridors: two north-south main corridors, two aisles wide
-        corridor = 2 * spec.aisle_width_m
-        third = (xmax - xmin - 2 * corridor) / 3
-        bands = [
-            (xmin + i * (third + corridor), xmin + i * (third + corridor) + third) for i in range(3)
-        ]
-    slots = _rack_shelves(spec, region, bands)
-    slots = np.array([s for s in slots if _allowed(s, spec, keepout)]).reshape(-1, 4)
+    # two_corridors: shelf bands between two north-south main corridors
+    ways = [[(xmin, xmax)]] if spec.layout == "all_rows" else _corridor_bands(spec, xmin, xmax)
+    slots = np.zeros((0, 4))
+    for bands in ways:  # the first way with room for every shelf, else the roomiest
+        found = _rack_shelves(spec, region, bands)
+        found = np.array([s for s in found if _allowed(s, spec, keepout)]).reshape(-1, 4)
+        if len(found) > len(slots):
+            slots = found
+        if len(slots) >= spec.shelf_count:
+            break
     if spec.shelf_count > len(slots):
         raise ModelError(
             "world.shelf_count",

@@ -213,6 +213,57 @@ def _check_obstacles(spec: WarehouseSpec) -> FloatArray:
     return boxes
 
 
+def _check_fleet(spec: WarehouseSpec) -> None:
+    """Refuse a fleet the room cannot hold, naming the most robots it can.
+
+    Docked robots stand in rows along the south wall and may take half the room; randomly
+    placed ones need a footprint each (an upper bound: shelves take more room).
+    """
+    width, height = spec.size_m
+    pitch = 2 * spec.robot_radius_m + DOCK_GAP_M
+    if spec.placement == "dock":
+        per_row = int((width - DOCK_GAP_M) // pitch)
+        rows = int((height / 2 - DOCK_GAP_M) // pitch)
+        most = max(per_row, 0) * max(rows, 0)
+        where = f"docked in rows of {max(per_row, 0)} in the south half of the"
+    elif spec.placement == "random":
+        most = int(width // pitch) * int(height // pitch)
+        where = "with room around each in the"
+    else:
+        return  # explicit poses are checked one by one
+    if spec.robot_count > most:
+        raise ModelError(
+            "robots.count",
+            spec.robot_count,
+            f"at most {most} robots of {2 * spec.robot_radius_m:g} m {where} "
+            f"{width:g} m x {height:g} m room",
+        )
+
+
+def _check_shelf_size(spec: WarehouseSpec, dock: float) -> None:
+    """Refuse shelves longer or deeper than the room leaves room for, naming the limit."""
+    aisle = spec.aisle_width_m
+    width, height = spec.size_m
+    free_x = width - 2 * aisle
+    free_y = height - dock - 2 * aisle
+    length, depth = spec.shelf_size_m
+    room = f"with {aisle:g} m aisles around them in the {width:g} m x {height:g} m room"
+    if min(length, depth) > max(free_x, free_y) or min(free_x, free_y) <= 0:
+        raise ModelError(
+            "world.shelf_size_m",
+            list(spec.shelf_size_m),
+            f"shelves at most {max(min(free_x, free_y), 0):.2f} m deep {room}",
+        )
+    short, long_ = sorted((length, depth))
+    longest = max(free_x if short <= free_y else 0.0, free_y if short <= free_x else 0.0)
+    if long_ > longest:
+        raise ModelError(
+            "world.shelf_size_m",
+            list(spec.shelf_size_m),
+            f"shelves at most {longest:.2f} m long ({short:g} m deep) {room}",
+        )
+
+
 def generate_warehouse(spec: WarehouseSpec, rng: np.random.Generator) -> Warehouse:
     """Generate a warehouse from its parameters.
 
@@ -225,6 +276,8 @@ def generate_warehouse(spec: WarehouseSpec, rng: np.random.Generator) -> Warehou
             free start slots, a start pose inside an obstacle).
     """
     width, height = spec.size_m
+    # the binding problem first: a fleet that cannot fit makes every other answer moot
+    _check_fleet(spec)
     if 2 * spec.robot_radius_m >= spec.aisle_width_m:
         raise ModelError(
             "world.aisle_width_m",
@@ -232,13 +285,9 @@ def generate_warehouse(spec: WarehouseSpec, rng: np.random.Generator) -> Warehou
             f"a width above the robot diameter ({2 * spec.robot_radius_m:g} m)",
         )
     dock = dock_depth(spec)
-    if dock > height / 2:
-        raise ModelError(
-            "robots.count",
-            spec.robot_count,
-            f"a fleet whose dock fits in half the room ({height / 2:g} m)",
-        )
     obstacles = _check_obstacles(spec)
+    if spec.shelf_count > 0:
+        _check_shelf_size(spec, dock)
     shelves = place_shelves(spec, dock, rng)
     world = Warehouse(
         size_m=(width, height),

@@ -14,6 +14,7 @@ from typing import Any
 from cosim.errors import ConfigError
 from cosim.scenario.fields import build, suggest
 from cosim.scenario.model import Scenario, section_types
+from cosim.scenario.tomlfile import parse_toml, read_toml_file
 
 PRESET_PACKAGE = "cosim.presets"
 
@@ -53,17 +54,10 @@ def _read_source(spec: str | Path) -> tuple[str, dict[str, Any]]:
         origin = f"preset {text_spec}"
         text = preset_text(text_spec)
     else:
-        origin = str(path)
         if not path.is_file():
             raise ConfigError(f"{path}: scenario file not found")
-        try:
-            text = path.read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError) as error:
-            raise ConfigError(f"{path}: cannot read scenario file ({error})") from None
-    try:
-        return origin, tomllib.loads(text)
-    except tomllib.TOMLDecodeError as error:
-        raise ConfigError(f"{origin}: malformed TOML: {error}") from None
+        return str(path), read_toml_file(path, "scenario file")
+    return origin, parse_toml(text, origin)
 
 
 def parse_override(text: str) -> tuple[str, Any]:
@@ -218,8 +212,4 @@ def dump_scenario(scenario: Scenario) -> str:
 
 def scenario_from_text(text: str, origin: str) -> Scenario:
     """Load a scenario from TOML text (used for round trips and tests)."""
-    try:
-        raw = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as error:
-        raise ConfigError(f"{origin}: malformed TOML: {error}") from None
-    return _build(raw, origin, {})
+    return _build(parse_toml(text, origin), origin, {})

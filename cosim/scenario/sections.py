@@ -49,17 +49,6 @@ class WorldConfig:
         (), "extra obstacle boxes [[xmin_m, ymin_m, xmax_m, ymax_m], ...] in map"
     )
 
-    def problems(self) -> Iterator[Problem]:
-        """Shelves must be smaller than the room."""
-        length, depth = self.shelf_size_m
-        if min(length, depth) + 2 * self.aisle_width_m > min(self.size_m):
-            yield Problem(
-                "shelf_size_m",
-                list(self.shelf_size_m),
-                f"shelves plus two aisles ({self.aisle_width_m:g} m) to fit in the room "
-                f"{list(self.size_m)}",
-            )
-
 
 @dataclass(frozen=True)
 class RobotsConfig:

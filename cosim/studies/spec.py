@@ -34,7 +34,6 @@ any of them is reported (file, key, value, expectation) and nothing runs.
 from __future__ import annotations
 
 import itertools
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -45,6 +44,7 @@ from cosim.runner import execute
 from cosim.scenario import load_scenario
 from cosim.scenario.fields import suggest
 from cosim.scenario.loader import preset_names
+from cosim.scenario.tomlfile import read_toml_file
 
 SECTIONS = ("study", "grid", "overrides", "cases", "report")
 STUDY_KEYS = ("name", "scenario", "seeds", "duration_s", "tables", "description")
@@ -153,10 +153,7 @@ def load_study(path: str | Path) -> StudySpec:
     path = Path(path)
     if not path.is_file():
         raise ConfigError(f"{path}: study file not found")
-    try:
-        raw = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
-        raise ConfigError(f"{path}: malformed TOML: {error}") from None
+    raw = read_toml_file(path, "study file")
     for section in raw:
         if section not in SECTIONS:
             raise ConfigError(

@@ -82,10 +82,28 @@ def test_cross_field_problems_name_the_key(tmp_path):
         cosim.load_scenario(_write(tmp_path, "[lidar]\nrange_min_m = 12.0\n"))
 
 
-def test_malformed_toml_is_reported_with_the_file(tmp_path):
-    path = _write(tmp_path, "[robots\ncount = 3\n")
-    with pytest.raises(ConfigError, match=rf"{path}: malformed TOML"):
+def test_malformed_toml_names_the_file_and_line_and_shows_the_line(tmp_path):
+    path = _write(tmp_path, '[scenario]\nname = "x"\n\n[robots\ncount = 3\n')
+    with pytest.raises(ConfigError) as error:
         cosim.load_scenario(path)
+    assert str(error.value) == (
+        f"{path}: line 4: [robots  <- expected ']' at the end of a table declaration "
+        "(malformed TOML)"
+    )
+
+
+def test_bytes_that_are_not_utf8_name_their_line(tmp_path):
+    path = tmp_path / "s.toml"
+    path.write_bytes(b'[robots]\ncount = 3\nname = "\xff"\n')
+    with pytest.raises(ConfigError, match=rf"{path}: line 3: byte 0xff is not UTF-8"):
+        cosim.load_scenario(path)
+
+
+def test_a_very_long_bad_line_is_shortened_in_the_message(tmp_path):
+    path = _write(tmp_path, "[robots]\ncount = " + "9 " * 200 + "\n")
+    with pytest.raises(ConfigError) as error:
+        cosim.load_scenario(path)
+    assert "line 2: count = 9 9" in str(error.value) and len(str(error.value)) < 250
 
 
 def test_a_missing_file_is_reported(tmp_path):
