@@ -10,7 +10,7 @@ import argparse
 import os
 import sys
 import traceback
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -25,15 +25,52 @@ from cosim.scenario import (
     preset_summary,
 )
 
-HIGHLIGHTS = (
-    ("arrivals", "goals reached"),
-    ("deadlocks", "stuck reports"),
-    ("collisions", "collisions"),
-    ("min_clearance_m", "m smallest clearance"),
-    ("messages_dropped", "messages dropped"),
-    ("latency_ms_p50", "ms median latency"),
+
+def _count(value: Any) -> str:
+    return f"{int(value):,}"
+
+
+HIGHLIGHTS: tuple[tuple[str, str, Callable[[Any], str]], ...] = (
+    ("arrivals", "goals reached", _count),
+    ("deadlocks", "stuck reports", _count),
+    ("collisions", "collisions", _count),
+    ("min_clearance_m", "m smallest clearance", lambda v: f"{v:.2f}"),
+    ("humans_near_misses", "near misses with people", _count),
+    ("map_iou", "map IoU", lambda v: f"{v:.2f}"),
+    ("messages_dropped", "messages dropped", _count),
+    ("latency_ms_p50", "ms median latency", lambda v: f"{v:.3g}"),
 )
-"""Summary metrics shown after a run, when the run has them."""
+"""Summary metrics shown after a run, when the run has them: key, label, format."""
+TASK_DRIVER_SKIPS = ("arrivals",)
+"""With tasks, goals reached are the tasks' legs: the tasks lead instead."""
+
+
+SINGULAR = {
+    "goals reached": "goal reached",
+    "stuck reports": "stuck report",
+    "collisions": "collision",
+    "near misses with people": "near miss with people",
+    "messages dropped": "message dropped",
+}
+
+
+def _singular(label: str) -> str:
+    return SINGULAR.get(label, label)
+
+
+def _tasks_phrase(s: dict[str, Any]) -> str | None:
+    """``12 tasks completed (6.5 per min, 24.2 s mean latency)``, with the task driver."""
+    done = s.get("tasks_completed")
+    if done is None:
+        return None
+    details = []
+    if s.get("tasks_per_min") is not None:
+        details.append(f"{s['tasks_per_min']:.3g} per min")
+    if s.get("mean_task_latency_s") is not None:
+        details.append(f"{s['mean_task_latency_s']:.3g} s mean latency")
+    noun = "task" if done == 1 else "tasks"
+    return f"{done:,} {noun} completed" + (f" ({', '.join(details)})" if details else "")
+
 
 if TYPE_CHECKING:
     from cosim.recording.session import RecordingSession
@@ -127,12 +164,21 @@ def _ready(session: RecordingSession, *, quiet: bool) -> None:
 
 def _print_run(result: RunResult, out: Path, figures: list[Path]) -> None:
     s = result.summary
+    factor = s.get("real_time_factor")
+    rate = f"{factor:.3g}x real time" if factor is not None else "real-time factor unknown"
     print(
         f"{s['scenario']} seed {s['seed']}: {s['sim_time_s']:g} s simulated in "
-        f"{s['wall_time_s']:.2f} s ({s['real_time_factor']:g}x real time), "
-        f"{s['robots']} robots, {s['events']} events, {s['messages_sent']} messages"
+        f"{s['wall_time_s']:.2f} s ({rate}), "
+        f"{s['robots']} robots, {s['events']:,} events, {s['messages_sent']:,} messages"
     )
-    highlights = [f"{s[key]} {label}" for key, label in HIGHLIGHTS if s.get(key) is not None]
+    tasks = _tasks_phrase(s)
+    skip = TASK_DRIVER_SKIPS if tasks is not None else ()
+    highlights = [tasks] if tasks is not None else []
+    highlights += [
+        f"{show(s[key])} {_singular(label) if s[key] == 1 else label}"
+        for key, label, show in HIGHLIGHTS
+        if s.get(key) is not None and key not in skip
+    ]
     if highlights:
         print("  " + ", ".join(highlights))
     tables = ", ".join(sorted(result.tables))

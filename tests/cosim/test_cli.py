@@ -1,4 +1,5 @@
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -343,3 +344,19 @@ def test_run_standin_without_a_physical_robot_is_refused(capsys, tmp_path):
 @pytest.mark.parametrize("preset", ["lab-real-in-virtual", "lab-mixed"])
 def test_the_mixed_reality_presets_check_without_touching_the_network(preset, capsys):
     assert main(["check", preset]) == 0
+
+
+def test_the_run_summary_leads_with_tasks_and_rounds_to_meaningful_digits(tmp_path, capsys):
+    out = tmp_path / "run"
+    assert main(["run", "warehouse-random", *SMALL, "--duration-s", "20", "--bag", "none",
+                 "--out", str(out)]) == 0  # fmt: skip
+    first, second = capsys.readouterr().out.splitlines()[:2]
+    assert re.fullmatch(
+        r"warehouse-random seed 1: 20 s simulated in \d+\.\d\d s \([\d.]+x real time\), "
+        r"3 robots, [\d,]+ events, [\d,]+ messages",
+        first,
+    )
+    assert re.match(r"  \d+ tasks? completed \([\d.]+ per min, [\d.]+ s mean latency\)", second)
+    assert "goals reached" not in second
+    clearance = re.search(r"(-?[\d.]+) m smallest clearance", second).group(1)
+    assert len(clearance.split(".")[1]) == 2
