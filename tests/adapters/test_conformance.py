@@ -12,7 +12,7 @@ from cosim.runner import execute
 
 REGISTRY = AdapterRegistry.from_entry_points()
 SMALL = {
-    "scenario.duration_s": 2.0,
+    "scenario.duration_s": 5.0,
     "world.size_m": [12.0, 12.0],
     "world.shelf_count": 4,
     "robots.count": 3,
