@@ -6,12 +6,14 @@ from dataclasses import dataclass
 
 from cosim.adapter import Adapter, RunContext
 from cosim.bus import Bus
-from cosim.errors import ConfigError
+from cosim.errors import ConfigError, ScenarioError
 from cosim.kernel import Kernel
 from cosim.records import Recorder
 from cosim.registry import AdapterRegistry
 from cosim.rng import RngStreams
+from cosim.scenario.fields import show_value
 from cosim.scenario.model import Scenario
+from models.errors import ModelError
 
 DRIVERS: dict[str, list[str]] = {
     "tasks": ["navigation", "task_source", "dta"],
@@ -103,6 +105,12 @@ def assemble(
     )
     adapters: list[tuple[str, Adapter]] = []
     for name in ordered:
-        adapters.append((name, registry.get(name)(run)))
+        try:
+            adapters.append((name, registry.get(name)(run)))
+        except ModelError as error:  # a model refusing its parameters: the user's input
+            raise ScenarioError(
+                f"{scenario.source}: {error.key} = {show_value(error.value)}: "
+                f"expected {error.expected}"
+            ) from None
     run.run_checks()
     return Assembly(run, adapters)

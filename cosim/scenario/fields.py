@@ -179,7 +179,17 @@ def _numbers(value: Any) -> Iterator[float]:
 
 def format_problem(origin: str, section: str, key: str, value: Any, expected: str) -> str:
     """Format the one-line message used for every configuration error."""
-    return f"{origin}: [{section}] {key} = {_show(value)}: expected {expected}"
+    return f"{origin}: [{section}] {key} = {show_value(value)}: expected {expected}"
+
+
+SHOWN_CHARS = 80
+"""Longest value a message shows; longer ones end in an ellipsis."""
+
+
+def show_value(value: Any) -> str:
+    """A value as TOML-like text on one line, at most :data:`SHOWN_CHARS` long."""
+    text = _show(value)
+    return text if len(text) <= SHOWN_CHARS else text[: SHOWN_CHARS - 3] + "..."
 
 
 def _show(value: Any) -> str:
@@ -188,8 +198,13 @@ def _show(value: Any) -> str:
     if isinstance(value, list | tuple):
         return "[" + ", ".join(_show(v) for v in value) + "]"
     if isinstance(value, dict):
-        return "{" + ", ".join(f"{k} = {_show(v)}" for k, v in value.items()) + "}"
-    return repr(value)
+        return "{" + ", ".join(f"{_key(k)} = {_show(v)}" for k, v in value.items()) + "}"
+    return repr(value)  # repr escapes newlines and control characters
+
+
+def _key(key: Any) -> str:
+    text = str(key)
+    return text if text.isidentifier() else repr(text)
 
 
 def suggest(name: str, options: list[str]) -> str:

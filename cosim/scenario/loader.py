@@ -162,7 +162,7 @@ def _apply_profile(
     if profiles is None:
         return table, origins
     name = table.get("profile", cls().profile)
-    if name not in profiles:
+    if not isinstance(name, str) or name not in profiles:
         where = origins.get("profile", origin)
         raise ConfigError(
             f"{where}: [{section}] profile = {name!r}: expected one of "

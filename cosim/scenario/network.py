@@ -134,7 +134,9 @@ class NetworkConfig:
         0.0, "gilbert_elliott: loss probability in good (netem 1-k)", ge=0, le=1
     )
     bandwidth_mbps: float = param(0.0, "sending rate of every host (Mbit/s), 0 = unlimited", ge=0)
-    queue_packets: int = param(100, "messages that may wait at a sending interface", ge=1)
+    queue_packets: int = param(
+        100, "messages that may wait at a sending interface", ge=1, le=1_000_000
+    )
     range_m: float = param(0.0, "robot-to-robot range cut-off (m), 0 = unlimited", ge=0)
     path_loss: bool = param(False, "log-distance path loss with shadowing between robots")
     path_loss_exponent: float = param(3.0, "path loss exponent (indoor obstructed ~3)", gt=0)
@@ -144,7 +146,7 @@ class NetworkConfig:
     )
     sensitivity_dbm: float = param(-82.0, "receiver sensitivity (dBm)")
     shadowing_db: float = param(4.0, "log-normal shadowing deviation (dB)", ge=0)
-    topology_update_hz: float = param(10.0, "rate of link up/down updates (Hz)", gt=0)
+    topology_update_hz: float = param(10.0, "rate of link up/down updates (Hz)", gt=0, le=1000)
     partitions: tuple[PartitionConfig, ...] = param((), "scheduled outages")
 
     def problems(self) -> Iterator[Problem]:

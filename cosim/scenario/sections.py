@@ -27,7 +27,7 @@ class ScenarioSection:
     """``[scenario]``: identity, length and seed of a run."""
 
     name: str = param("unnamed", "name shown in summaries and folder names")
-    duration_s: float = param(60.0, "simulated time to run (s)", gt=0)
+    duration_s: float = param(60.0, "simulated time to run (s)", gt=0, le=1e7)
     seed: int = param(1, "scenario seed; every random stream derives from it", ge=0)
     adapters: tuple[str, ...] = param((), "extra adapters to start, by registered name")
 
@@ -36,15 +36,17 @@ class ScenarioSection:
 class WorldConfig:
     """``[world]``: the warehouse hall (frame ``map``, origin at the south-west inner corner)."""
 
-    size_m: tuple[float, float] = param((30.0, 30.0), "inner room size [x, y] (m)", gt=0)
+    size_m: tuple[float, float] = param((30.0, 30.0), "inner room size [x, y] (m)", gt=0, le=500.0)
     layout: Layout = param("random", "shelf layout")
     shelf_size_m: tuple[float, float] = param(
         (2.0, 0.8), "shelf footprint [length, depth] (m)", gt=0
     )
-    shelf_count: int = param(24, "number of shelves (rows layouts: at most what fits)", ge=0)
+    shelf_count: int = param(
+        24, "number of shelves (rows layouts: at most what fits)", ge=0, le=100_000
+    )
     shelves_per_rack: int = param(3, "rows layouts: shelves end to end in one rack", ge=1)
     aisle_width_m: float = param(1.6, "minimum free gap between shelves and walls (m)", gt=0)
-    wall_thickness_m: float = param(0.2, "thickness of the outer walls (m)", gt=0)
+    wall_thickness_m: float = param(0.2, "thickness of the outer walls (m)", gt=0, le=5.0)
     obstacles: tuple[tuple[float, float, float, float], ...] = param(
         (), "extra obstacle boxes [[xmin_m, ymin_m, xmax_m, ymax_m], ...] in map"
     )
@@ -54,7 +56,7 @@ class WorldConfig:
 class RobotsConfig:
     """``[robots]``: the fleet (differential drive, Jackal defaults)."""
 
-    count: int = param(4, "number of robots", gt=0)
+    count: int = param(4, "number of robots", gt=0, le=100_000)
     model: Literal["jackal"] = param("jackal", "robot model")
     placement: Placement = param("dock", "start placement")
     positions: tuple[tuple[float, float, float], ...] = param(
@@ -65,7 +67,7 @@ class RobotsConfig:
     max_yaw_rate_radps: float = param(2.0, "yaw-rate limit (rad/s)", gt=0)
     max_accel_mps2: float = param(2.0, "linear acceleration limit (m/s^2)", gt=0)
     max_yaw_accel_radps2: float = param(3.0, "yaw acceleration limit (rad/s^2)", gt=0)
-    radius_m: float = param(0.33, "footprint radius (m)", gt=0)
+    radius_m: float = param(0.33, "footprint radius (m)", gt=0, le=5.0)
     control_hz: float = param(20.0, "kinematics and odometry rate (Hz)", gt=0, le=1000)
     driver: Literal["tasks", "navigation", "waypoints", "wander"] = param(
         "navigation",
@@ -94,7 +96,7 @@ class RobotsConfig:
 class LidarConfig:
     """``[lidar]``: a planar lidar on every robot (REP 117 ranges)."""
 
-    beams: int = param(360, "beams per scan (0 disables the lidar)", ge=0)
+    beams: int = param(360, "beams per scan (0 disables the lidar)", ge=0, le=100_000)
     fov_deg: float = param(
         360.0, "field of view (deg), centred on the robot's heading", gt=0, le=360
     )
@@ -138,6 +140,7 @@ class RecordConfig:
         "ground-truth sampling rate for tables/poses and the bag's /tf, /clock and "
         "/robot_i/ground_truth (Hz)",
         gt=0,
+        le=1000,
     )
     messages: bool = param(True, "keep one row per message in tables/messages")
     tables: bool = param(True, "write tables/*.parquet")
@@ -180,7 +183,7 @@ class NavigationConfig:
     robots_layer: bool = param(
         False, "robots broadcast pose and footprint over the network; others avoid them"
     )
-    robots_layer_hz: float = param(5.0, "robots layer broadcast rate (Hz)", gt=0)
+    robots_layer_hz: float = param(5.0, "robots layer broadcast rate (Hz)", gt=0, le=1000)
     robots_layer_timeout_s: float = param(1.0, "forget a robot not heard from for (s)", gt=0)
     resolution_m: float = param(0.1, "costmap cell size (m)", gt=0, le=1)
     inflation_radius_m: float = param(1.0, "inflation radius (m)", gt=0)
@@ -194,7 +197,7 @@ class NavigationConfig:
         "before the fleet layer re-targets them",
         gt=0,
     )
-    progress_hz: float = param(1.0, "rate of `progress` status reports (Hz)", gt=0)
+    progress_hz: float = param(1.0, "rate of `progress` status reports (Hz)", gt=0, le=1000)
     goals: tuple[tuple[float, float], ...] = param(
         (),
         "driver 'navigation': a series of goals [[x_m, y_m], ...] in map, visited in order "
@@ -209,8 +212,8 @@ class TasksConfig:
     As in the paper, a new task appears whenever one is completed.
     """
 
-    initial: int = param(4, "tasks open at the start", ge=1)
-    max_total: int = param(0, "tasks created over the run, 0 = unlimited", ge=0)
+    initial: int = param(4, "tasks open at the start", ge=1, le=100_000)
+    max_total: int = param(0, "tasks created over the run, 0 = unlimited", ge=0, le=10_000_000)
     eligibility_prob: float = param(
         1.0,
         "probability that a robot may serve a task (ChoiRbot's example uses a subset)",
