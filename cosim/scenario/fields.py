@@ -217,6 +217,24 @@ def suggest(name: str, options: list[str]) -> str:
 
 T = TypeVar("T")
 
+SMALLEST = {"_hz": 1e-3, "_ms": 1e-3, "_s": 1e-6}
+"""Smallest positive value of a rate or time (by unit suffix) where only ``> 0`` is declared:
+a rate of 1e-308 Hz is a period no clock can hold."""
+LARGEST = {"_hz": 1e6, "_ms": 1e12, "_s": 1e9}
+"""Largest rate or time (by unit suffix) where none is declared: a MHz tick is already a
+billion events a run; 1e9 s (32 years) is near the kernel's int64 nanosecond clock."""
+
+
+def implicit_bounds(key: str, bounds: Bounds) -> Bounds:
+    """The declared bounds, plus the limits every rate and time keeps (by the key's unit)."""
+    for suffix, smallest in SMALLEST.items():
+        if key.endswith(suffix) and bounds.gt == 0 and bounds.ge is None:
+            bounds = dataclasses.replace(bounds, gt=None, ge=smallest)
+    for suffix, largest in LARGEST.items():
+        if key.endswith(suffix) and bounds.le is None and bounds.lt is None:
+            bounds = dataclasses.replace(bounds, le=largest)
+    return bounds
+
 
 def field_names(cls: type[Any]) -> list[str]:
     """Names of a section's fields in declaration order."""
@@ -258,7 +276,7 @@ def build(
         if nested is not None:
             values[key] = _build_tables(nested, raw, section=f"{section}.{key}", origin=origin)
             continue
-        bounds: Bounds = fields[key].metadata.get("bounds", Bounds())
+        bounds = implicit_bounds(key, fields[key].metadata.get("bounds", Bounds()))
         bound_text = bounds.describe()
         try:
             value = coerce(raw, hint)

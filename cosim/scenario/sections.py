@@ -186,7 +186,7 @@ class NavigationConfig:
     robots_layer_hz: float = param(5.0, "robots layer broadcast rate (Hz)", gt=0, le=1000)
     robots_layer_timeout_s: float = param(1.0, "forget a robot not heard from for (s)", gt=0)
     resolution_m: float = param(0.1, "costmap cell size (m)", gt=0, le=1)
-    inflation_radius_m: float = param(1.0, "inflation radius (m)", gt=0)
+    inflation_radius_m: float = param(1.0, "inflation radius (m)", gt=0, le=10.0)
     cost_scaling: float = param(3.0, "inflation cost scaling factor (1/m)", gt=0)
     lookahead_m: float = param(1.0, "carrot distance ahead on the path (m)", gt=0)
     goal_tolerance_m: float = param(0.25, "distance at which a goal is reached (m)", gt=0)

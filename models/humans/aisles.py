@@ -142,7 +142,10 @@ def _lines(extents: FloatArray, size: float, clearance: float, spacing: float) -
     for lo, hi in itertools.pairwise(bounds):
         parts = int((hi - lo) // (FILL_FACTOR * spacing))
         filled.extend(np.linspace(lo, hi, parts + 2)[1:-1].tolist() if parts > 0 else [])
-    return np.array(sorted(lines + filled), dtype=float)
+    result = sorted(lines + filled)
+    if len(result) < 2:  # an open room: at least two lines to cross
+        result = sorted({*result, size / 4, 3 * size / 4})
+    return np.array(result, dtype=float)
 
 
 def _clearance(points: FloatArray, boxes: FloatArray, width: float, height: float) -> FloatArray:

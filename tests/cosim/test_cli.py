@@ -123,7 +123,7 @@ def test_run_refuses_a_non_empty_output_folder_unless_forced(tmp_path):
     [
         ("[lidar]\nrate_hzz = 10\n", "unknown key 'rate_hzz'; did you mean 'rate_hz'?"),
         ('[robots]\ncount = "4"\n', "[robots] count = '4': expected an integer > 0"),
-        ("[lidar]\nrate_hz = -1\n", "[lidar] rate_hz = -1: expected a number > 0"),
+        ("[lidar]\nrate_hz = -1\n", "[lidar] rate_hz = -1: expected a number >= 0.001"),
         ("[robots]\ncount = 0\n", "[robots] count = 0: expected an integer > 0"),
         ("[robots\ncount = 0\n", "malformed TOML"),
     ],

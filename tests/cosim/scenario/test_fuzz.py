@@ -114,17 +114,22 @@ def test_arbitrary_bytes_in_a_scenario_file_are_refused_in_one_line(data, at, tm
 
 
 @pytest.mark.parametrize(("section", "key"), NUMERIC)
-@pytest.mark.parametrize("value", [math.nan, math.inf, -math.inf, 1e308, -1e308, 2**63, -1])
+@pytest.mark.parametrize("value", [math.nan, math.inf, -math.inf, 1e308, -1e308, 1e-308, 2**63, -1])
 def test_extreme_numbers_in_every_numeric_key_are_accepted_or_refused_naming_the_key(
     section, key, value
 ):
     try:
         scenario = cosim.load_scenario("warehouse-random", {f"{section}.{key}": value})
     except CosimError as error:
-        _one_line(str(error), f"{section}.{key}")
+        # the key itself, or (a cross-field rule) its section
+        _one_line(str(error), f"[{section}]" if f"{section}.{key}" not in str(error) else key)
         return
     got = getattr(getattr(scenario, section), key)
     assert isinstance(got, (int, float)) and math.isfinite(got)  # never NaN or inf inside
+    if key.endswith(("_hz", "_ms", "_s")):
+        assert got <= 1e12  # a rate or time a nanosecond clock can hold
+    if key.endswith("_hz"):
+        assert got >= 1e-3
 
 
 @settings(

@@ -45,14 +45,19 @@ def test_a_value_of_the_wrong_type_names_key_value_and_expectation(tmp_path):
     path = _write(tmp_path, '[robots]\ncount = "four"\n')
     with pytest.raises(ConfigError) as error:
         cosim.load_scenario(path)
-    assert str(error.value) == f"{path}: [robots] count = 'four': expected an integer > 0"
+    assert (
+        str(error.value)
+        == f"{path}: [robots] count = 'four': expected an integer > 0 and <= 100000"
+    )
 
 
 def test_a_negative_rate_is_rejected(tmp_path):
     path = _write(tmp_path, "[lidar]\nrate_hz = -10\n")
     with pytest.raises(ConfigError) as error:
         cosim.load_scenario(path)
-    assert str(error.value) == f"{path}: [lidar] rate_hz = -10: expected a number > 0 and <= 1000"
+    assert (
+        str(error.value) == f"{path}: [lidar] rate_hz = -10: expected a number >= 0.001 and <= 1000"
+    )
 
 
 def test_zero_robots_are_rejected(tmp_path):
@@ -119,7 +124,9 @@ def test_an_unknown_preset_suggests_the_nearest_one():
 def test_overrides_are_type_checked_and_name_their_origin():
     with pytest.raises(ConfigError) as error:
         cosim.load_scenario("warehouse-random", {"lidar.beams": 2.5})
-    assert str(error.value) == "--set lidar.beams: [lidar] beams = 2.5: expected an integer >= 0"
+    assert str(error.value) == (
+        "--set lidar.beams: [lidar] beams = 2.5: expected an integer >= 0 and <= 100000"
+    )
 
 
 def test_overrides_replace_file_values():
