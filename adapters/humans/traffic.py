@@ -302,7 +302,9 @@ def _graph(run: RunContext, world: Warehouse) -> tuple[AisleGraph, Spots, Spots]
         )
         stations = pick_stations(world, graph, cfg.stations, run.rng.stream("humans/stations"))
     except ModelError as error:
+        # the graph is asked for the radius plus a margin: name what the user wrote
+        value = cfg.worker_radius_m if error.key == "humans.worker_radius_m" else error.value
         raise ScenarioError(
-            f"{run.scenario.source}: {error.key} = {error.value!r}: expected {error.expected}"
+            f"{run.scenario.source}: {error.key} = {value!r}: expected {error.expected}"
         ) from None
     return graph, stations, dock_points(graph)

@@ -115,7 +115,8 @@ def aisle_graph(world: Warehouse, *, clearance_m: float, spacing_m: float) -> Ai
         raise ModelError(
             "humans.worker_radius_m",
             clearance_m,
-            "a person narrow enough to walk between the shelves (no aisle is that wide)",
+            f"a person narrow enough to walk between the shelves (no line through the room "
+            f"keeps {clearance_m:g} m from every shelf and wall)",
         )
     pairs, least = _largest_part(len(grid), pairs, least)
     nodes, pairs, least = _merge_chains(grid, pairs, least)

@@ -241,12 +241,12 @@ def test_forklifts_drive_and_are_seen_as_two_discs_each():
 
 def test_a_room_too_narrow_for_people_is_one_line_and_exit_status_2(capsys):
     status = main(
-        ["run", "lab-mixed", "--set", "humans.workers=2", "--set", "humans.worker_radius_m=0.9",
+        ["run", "lab-mixed", "--set", "humans.workers=2", "--set", "humans.worker_radius_m=1.0",
          "--duration-s", "1", "--bag", "none"]
     )  # fmt: skip
     err = capsys.readouterr().err
     assert status == 2
-    assert "humans.worker_radius_m" in err and "Traceback" not in err
+    assert "humans.worker_radius_m = 1.0:" in err and "Traceback" not in err
     assert len(err.strip().splitlines()) == 1
 
 
