@@ -21,7 +21,7 @@ from PIL import Image
 from cosim.errors import ExportError
 from cosim.plotting.canvas import Color, fleet_colors
 from cosim.plotting.fleet import FleetLayer, fleet_handles
-from cosim.plotting.people import FORKLIFT_COLOR, PERSON_COLOR, PeopleLayer, people_handles
+from cosim.plotting.people import PeopleLayer, people_handles, people_inks
 from cosim.plotting.rays import LidarRays
 from cosim.plotting.rundata import RunData
 from cosim.plotting.world import (
@@ -109,13 +109,13 @@ def animation_gif(
     canvas.draw()  # type: ignore[no-untyped-call]  # the world, axes, legend; once
     canvas.draw()  # type: ignore[no-untyped-call]  # again: the layout settles
     background = canvas.copy_from_bbox(figure.bbox)  # type: ignore[no-untyped-call]
+    # people's inks only with people: a palette entry more would requantize every frame
     inks: list[Color | str] = [
         *colors,
         RAY_COLOR,
         SHELF_MUTED,
         OBSTACLE_COLOR,
-        PERSON_COLOR,
-        FORKLIFT_COLOR,
+        *people_inks(run),
         *INKS,
     ]
     palette = _palette(inks, robots=len(colors))

@@ -103,6 +103,13 @@ def draw_tracks(ax: Axes, run: RunData) -> None:
     )
 
 
+def people_inks(run: RunData) -> list[str]:
+    """The colours people add to a run's drawings: none for a run without people."""
+    if run.humans is None:
+        return []
+    return [PERSON_COLOR, FORKLIFT_COLOR]
+
+
 def people_handles(run: RunData) -> list[Line2D]:
     """Legend entries for the people and forklifts of the run (none without them)."""
     if run.humans is None:
