@@ -202,6 +202,12 @@ def _show(value: Any) -> str:
     return repr(value)  # repr escapes newlines and control characters
 
 
+def show_name(name: str) -> str:
+    """A section or key name as written, quoted when it holds spaces or control characters."""
+    shown = name if name and name.isprintable() and name.strip() == name else repr(name)
+    return shown if len(shown) <= SHOWN_CHARS else shown[: SHOWN_CHARS - 3] + "..."
+
+
 def _key(key: Any) -> str:
     text = str(key)
     return text if text.isidentifier() else repr(text)

@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from cosim.errors import ConfigError
-from cosim.scenario.fields import build, suggest
+from cosim.scenario.fields import build, show_name, show_value, suggest
 from cosim.scenario.model import Scenario, section_types
 from cosim.scenario.tomlfile import parse_toml, read_toml_file
 
@@ -120,11 +120,11 @@ def _build(raw: dict[str, Any], origin: str, origins: dict[tuple[str, str], str]
         if section not in types:
             where = next((o for (s, _), o in origins.items() if s == section), origin)
             raise ConfigError(
-                f"{where}: unknown section [{section}]" + suggest(section, list(types))
+                f"{where}: unknown section [{show_name(section)}]" + suggest(section, list(types))
             )
         if not isinstance(table, dict):
             raise ConfigError(
-                f"{origin}: {section} = {table!r}: expected a [{section}] table of keys"
+                f"{origin}: {section} = {show_value(table)}: expected a [{section}] table of keys"
             )
         key_origins = {key: origins.get((section, key), origin) for key in table}
         table, key_origins = _apply_profile(types[section], table, key_origins, section, origin)

@@ -42,7 +42,7 @@ from cosim.assembly import adapter_names
 from cosim.errors import ConfigError
 from cosim.runner import execute
 from cosim.scenario import load_scenario
-from cosim.scenario.fields import suggest
+from cosim.scenario.fields import show_name, suggest
 from cosim.scenario.loader import preset_names
 from cosim.scenario.tomlfile import read_toml_file
 
@@ -157,7 +157,7 @@ def load_study(path: str | Path) -> StudySpec:
     for section in raw:
         if section not in SECTIONS:
             raise ConfigError(
-                f"{path}: unknown section [{section}]" + suggest(section, list(SECTIONS))
+                f"{path}: unknown section [{show_name(section)}]" + suggest(section, list(SECTIONS))
             )
     study = raw.get("study")
     if not isinstance(study, dict):

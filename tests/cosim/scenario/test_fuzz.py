@@ -38,7 +38,11 @@ values = st.recursive(
     ),
     max_leaves=8,
 )
-names = st.one_of(st.sampled_from(sorted(SECTIONS)), st.text(min_size=1, max_size=8))
+names = st.one_of(
+    st.sampled_from(sorted(SECTIONS)),
+    st.text(min_size=1, max_size=8),
+    st.sampled_from(["\n", " robots", "\t", "x\ry", "\x00", "robots\n"]),
+)
 
 
 def toml_value(value):
@@ -74,7 +78,7 @@ def documents(draw):
         if draw(st.booleans()):
             section, key = draw(st.sampled_from(KNOWN))
         else:
-            section, key = draw(names), draw(st.text(min_size=1, max_size=8))
+            section, key = draw(names), draw(names)
         doc.setdefault(section, {})[key] = draw(values)
     return doc
 
@@ -166,10 +170,10 @@ def studies(draw):
             st.one_of(
                 st.sampled_from(["seeds", "duration_s", "tables", "x", "metrics", "name"]),
                 st.sampled_from([f"{s}.{k}" for s, k in KNOWN]),
-                st.text(min_size=1, max_size=8),
+                names,
             )
         )
-        doc.setdefault(section, {})[key] = draw(values)
+        doc.setdefault(draw(st.one_of(st.just(section), names)), {})[key] = draw(values)
     return doc
 
 
