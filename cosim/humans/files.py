@@ -5,13 +5,13 @@ the run's traffic with ``sumo-gui -c humans.sumocfg`` and see what the robots sa
 
 The network keeps the ``map`` frame (``--offset.disable-normalization``): SUMO's x, y are
 cosim's. Each aisle edge ``e<k>`` is one lane centred on the aisle line, as wide as the
-aisle allows, open to pedestrians and to the robots' mirrors (vClass ``custom1``); with forklifts,
-they (vClass ``custom2``) drive on it and on its reverse twin ``r<k>``. The twin is open
-to pedestrians too: a lane closed to them would split the junctions' walking areas (SUMO
-lets people cross a road only on a crossing). netconvert lays the twins side by side,
-each right of the line, so with forklifts each twin is half the aisle wide: like traffic
-on a road, forklifts keep right; people walk on either half and SUMO's people see one
-another and the robots only on the same half.
+aisle less ``inset_m`` (a person's width), open to pedestrians and to the robots' mirrors
+(vClass ``custom1``). With forklifts (vClass ``custom2``), they drive on it and on its
+reverse twin ``r<k>``, which is open to pedestrians too: a lane closed to them would split
+the junctions' walking areas (SUMO lets people cross a road only on a crossing).
+netconvert lays the twins side by side, each right of the line, so with forklifts each
+twin is half the aisle wide: like traffic on a road, forklifts keep right; people walk on
+either half, and SUMO's people see one another and the robots only on the same half.
 """
 
 from __future__ import annotations
