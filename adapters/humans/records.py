@@ -18,7 +18,6 @@ from cosim.scenario.humans import HumansConfig
 from cosim.timebase import NS_PER_S, period_ns
 from models.humans.encounters import HALT_MPS, Encounters
 from models.kinematics import FleetState
-from models.obstacles import DynamicObstacles
 from models.tasks.book import TaskStatus
 
 if TYPE_CHECKING:
@@ -45,7 +44,7 @@ class HumanRecords:
         self.met: dict[str, list[int]] = {name: [] for name in self.fleet.names}
         """Per robot, the instants of its near misses and stops caused by people (ns)."""
 
-    def sample(self, now_ns: int, people: People, dynamic: DynamicObstacles) -> None:
+    def sample(self, now_ns: int, people: People) -> None:
         """Take the people at ``now_ns`` into the table and the metrics."""
         t_s = now_ns / NS_PER_S
         if now_ns >= self.next_record_ns and people.names:
@@ -63,12 +62,7 @@ class HumanRecords:
         self.seen.update(people.names)
         fleet = self.fleet
         robots = np.column_stack([fleet.x, fleet.y, fleet.radius_m])
-        discs = dynamic.discs
-        names = dynamic.names
-        mine = [k for k, name in enumerate(names) if dynamic.kind(k) in PEOPLE_KINDS]
-        began, stops = self.encounters.update(
-            robots, fleet.v, discs[mine], [names[k] for k in mine]
-        )
+        began, stops = self.encounters.update(robots, fleet.v, people.discs, people.disc_names)
         for e in began + stops:
             self.met[fleet.names[e.robot]].append(now_ns)
         for e in began:

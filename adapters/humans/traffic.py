@@ -71,6 +71,8 @@ class People:
         names: their ids.
         kinds: ``person`` or ``forklift`` per id.
         x_m, y_m, yaw_rad, speed_mps: their poses and speeds (``map``).
+        discs, disc_names: the (k, 3) discs ``x_m, y_m, radius_m`` that lidars and collision
+            checks see (two per forklift), and whose each disc is.
     """
 
     def __init__(self) -> None:
@@ -80,6 +82,8 @@ class People:
         self.y_m = np.zeros(0)
         self.yaw_rad = np.zeros(0)
         self.speed_mps = np.zeros(0)
+        self.discs = np.zeros((0, 3))
+        self.disc_names: list[str] = []
         self.forklift_size_m = (0.0, 0.0)
         self.worker_radius_m = 0.0
 
@@ -174,7 +178,7 @@ class HumansAdapter:
             self._give_way(now_ns, session)
         self.steps += 1
         self.coupling_s += time.perf_counter() - began
-        self.records.sample(now_ns, self.people, self.dynamic)
+        self.records.sample(now_ns, self.people)
 
     def _publish(self, walkers: Movers, drivers: Movers | None) -> None:
         cfg = self.cfg
@@ -198,7 +202,9 @@ class HumansAdapter:
             y.append(cy)
             yaw.append(drivers.yaw_rad)
             speed.append(drivers.speed_mps)
-        self.dynamic.update("humans", np.vstack(discs), names, kinds)
+        people.discs = np.vstack(discs)
+        people.disc_names = names
+        self.dynamic.update("humans", people.discs, names, kinds)
         people.names = list(walkers.names) + (list(drivers.names) if drivers is not None else [])
         people.kinds = ["person"] * len(walkers.names) + ["forklift"] * (
             len(people.names) - len(walkers.names)

@@ -30,6 +30,7 @@ from traci import constants as tc
 from cosim.errors import BridgeError
 from cosim.humans.files import sumo_tool
 from models.arrays import FloatArray
+from models.kinematics import wrap_angle
 
 SUMO_ERRORS: tuple[type[BaseException], ...] = (
     libsumo.TraCIException,
@@ -72,8 +73,7 @@ class Movers:
 
 def yaw_of_angle(angle_deg: FloatArray) -> FloatArray:
     """SUMO's heading (deg, clockwise from north) as yaw (rad, counter-clockwise from +x)."""
-    yaw: FloatArray = np.mod(np.radians(90.0 - np.asarray(angle_deg)) + np.pi, 2 * np.pi) - np.pi
-    return yaw
+    return wrap_angle(np.radians(90.0 - np.asarray(angle_deg)))
 
 
 def angle_of_yaw(yaw_rad: float) -> float:
@@ -84,13 +84,12 @@ def angle_of_yaw(yaw_rad: float) -> float:
 class SumoSession:
     """A SUMO simulation loaded from a ``.sumocfg`` and stepped from outside."""
 
-    def __init__(self, config: Path, *, seed: int, extra: Sequence[str] = ()) -> None:
+    def __init__(self, config: Path, *, seed: int) -> None:
         """Load ``config``.
 
         Args:
             config: the ``.sumocfg`` (network and demand beside it).
             seed: SUMO's random seed.
-            extra: more SUMO options.
 
         Raises:
             BridgeError: if SUMO refuses the files (its error line is in the message).
@@ -105,7 +104,6 @@ class SumoSession:
             "--no-warnings", "true",
             "--no-step-log", "true",
             "--duration-log.disable", "true",
-            *extra,
         ]  # fmt: skip
         self.in_process = _LIBSUMO.acquire(blocking=False)
         self._api: Any = libsumo

@@ -16,6 +16,8 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Patch, Polygon
 
 from cosim.plotting.rundata import RunData
+from models.arrays import FloatArray
+from models.humans.bodies import two_disc_cover
 
 PERSON_COLOR = "#1c1c1c"
 """Workers: near-black discs with a white rim, unlike any robot's colour (robots take
@@ -25,11 +27,10 @@ FORKLIFT_COLOR = "#edc948"
 TRACK_ALPHA = 0.35
 
 
-class PeopleLayer:
-    """Everyone SUMO moved, at one time; empty for runs without people."""
+class PeopleSamples:
+    """``tables/humans`` by sample time: who was where at any time of the run."""
 
-    def __init__(self, ax: Axes, run: RunData) -> None:
-        """Create the (empty) artists on ``ax``."""
+    def __init__(self, run: RunData) -> None:
         humans = run.humans
         self.frame = (
             humans.sort_values(["t_s", "id"], kind="stable").reset_index(drop=True)
@@ -45,14 +46,6 @@ class PeopleLayer:
         cfg = run.scenario.humans
         self.radius_m = cfg.worker_radius_m
         self.size_m = cfg.forklift_size_m
-        self.people = PatchCollection(
-            [], facecolor=PERSON_COLOR, edgecolor="white", linewidths=0.8, zorder=5
-        )
-        self.forklifts = PatchCollection(
-            [], facecolor=FORKLIFT_COLOR, edgecolor="0.15", linewidths=0.6, zorder=5
-        )
-        ax.add_collection(self.people)
-        ax.add_collection(self.forklifts)
 
     def at(self, t_s: float) -> pd.DataFrame | None:
         """The rows of the latest sample at or before ``t_s`` (None before the first)."""
@@ -62,6 +55,45 @@ class PeopleLayer:
         if k < 0:
             return None
         return self.frame.iloc[self.starts[k] : self.starts[k + 1]]
+
+    def discs(self, t_s: float) -> FloatArray:
+        """(k, 3) discs ``x_m, y_m, radius_m`` of everyone at ``t_s``, as the lidar saw them.
+
+        A worker is one disc; a forklift two, covering its body.
+        """
+        rows = self.at(t_s)
+        if rows is None:
+            return np.zeros((0, 3))
+        people = rows[rows["kind"] != "forklift"]
+        forklifts = rows[rows["kind"] == "forklift"]
+        xy = people[["x_m", "y_m"]].to_numpy()
+        return np.vstack(
+            [
+                np.column_stack([xy, np.full(len(xy), self.radius_m)]),
+                two_disc_cover(
+                    forklifts["x_m"].to_numpy(),
+                    forklifts["y_m"].to_numpy(),
+                    forklifts["yaw_rad"].to_numpy(),
+                    *self.size_m,
+                ),
+            ]
+        )
+
+
+class PeopleLayer(PeopleSamples):
+    """Everyone SUMO moved, at one time; empty for runs without people."""
+
+    def __init__(self, ax: Axes, run: RunData) -> None:
+        """Create the (empty) artists on ``ax``."""
+        super().__init__(run)
+        self.people = PatchCollection(
+            [], facecolor=PERSON_COLOR, edgecolor="white", linewidths=0.8, zorder=5
+        )
+        self.forklifts = PatchCollection(
+            [], facecolor=FORKLIFT_COLOR, edgecolor="0.15", linewidths=0.6, zorder=5
+        )
+        ax.add_collection(self.people)
+        ax.add_collection(self.forklifts)
 
     def show(self, t_s: float) -> list[Artist]:
         """Move the people to time ``t_s`` (s); return the artists (to redraw)."""

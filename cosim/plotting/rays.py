@@ -2,9 +2,9 @@
 
 The run does not store its scans; they are cast again with the project's batched caster
 (:func:`models.raycast.cast_batch`, as :mod:`adapters.sensing.lidar` calls it) against the
-static world and the other robots at each pose sample: the exact ranges, before the
-sensor model's noise and dropout. Dynamic obstacles (human traffic) are not in a run's
-tables and are not seen.
+static world, the other robots and the people (``tables/humans``, the latest sample at
+or before the pose) at each pose sample: the exact ranges, before the sensor model's
+noise and dropout.
 """
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ import math
 
 import numpy as np
 
+from cosim.plotting.people import PeopleSamples
 from cosim.plotting.rundata import RunData
 from models.arrays import BoolArray, FloatArray
 from models.lidar import ScanGeometry
@@ -47,6 +48,7 @@ class LidarRays:
         self.scene = StaticScene(run.warehouse.segments(), cell_m=SCENE_CELL_M)
         self.track = run.track
         self.robot = robot
+        self.people = PeopleSamples(run)
 
     def cast(self, i: int) -> tuple[FloatArray, FloatArray, BoolArray]:
         """The beams at pose sample ``i``.
@@ -61,7 +63,12 @@ class LidarRays:
         if not len(self.angles) or not np.isfinite(origin).all():
             return origin, np.zeros((0, 2)), np.zeros(0, dtype=bool)
         present = np.flatnonzero(np.isfinite(x) & np.isfinite(y))
-        circles = np.column_stack([x[present], y[present], np.full(len(present), self.radius_m)])
+        circles = np.vstack(
+            [
+                np.column_stack([x[present], y[present], np.full(len(present), self.radius_m)]),
+                self.people.discs(float(self.track.t_s[i])),
+            ]
+        )
         own = np.array([int(np.searchsorted(present, self.robot))], dtype=np.int64)
         heading = float(yaw[self.robot])
         ranges = cast_batch(

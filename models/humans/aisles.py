@@ -99,7 +99,7 @@ def aisle_graph(world: Warehouse, *, clearance_m: float, spacing_m: float) -> Ai
     ys = _lines(boxes[:, [1, 3]], height, clearance_m, spacing_m)
     gx, gy = np.meshgrid(xs, ys, indexing="ij")
     grid = np.stack([gx.ravel(), gy.ravel()], axis=1)
-    free = _clearance(grid, boxes, width, height) >= clearance_m
+    free = world.clearance(grid) >= clearance_m
     index = np.arange(len(grid)).reshape(len(xs), len(ys))
     pairs = np.concatenate(
         [
@@ -108,7 +108,7 @@ def aisle_graph(world: Warehouse, *, clearance_m: float, spacing_m: float) -> Ai
         ]
     )
     pairs = pairs[free[pairs[:, 0]] & free[pairs[:, 1]]]
-    least = _segment_clearance(grid, pairs, boxes, width, height)
+    least = _segment_clearance(world, grid, pairs)
     keep = least >= clearance_m
     pairs, least = pairs[keep], least[keep]
     if len(pairs) == 0:
@@ -149,24 +149,17 @@ def _lines(extents: FloatArray, size: float, clearance: float, spacing: float) -
     return np.array(result, dtype=float)
 
 
-def _clearance(points: FloatArray, boxes: FloatArray, width: float, height: float) -> FloatArray:
-    walls = np.minimum.reduce(
-        [points[:, 0], points[:, 1], width - points[:, 0], height - points[:, 1]]
-    )
-    inner: FloatArray = np.minimum(box_distance(points, boxes).min(axis=1), walls)
-    return inner
-
-
-def _segment_clearance(
-    grid: FloatArray, pairs: IntArray, boxes: FloatArray, width: float, height: float
-) -> FloatArray:
-    """The smallest clearance along each segment (m), sampled every ``SAMPLE_M``."""
-    least = np.full(len(pairs), np.inf)
-    for k, (i, j) in enumerate(pairs.tolist()):
-        a, b = grid[i], grid[j]
-        n = max(2, int(np.ceil(np.hypot(*(b - a)) / SAMPLE_M)) + 1)
-        t = np.linspace(0.0, 1.0, n)[:, None]
-        least[k] = _clearance(a + t * (b - a), boxes, width, height).min()
+def _segment_clearance(world: Warehouse, grid: FloatArray, pairs: IntArray) -> FloatArray:
+    """The smallest clearance along each segment (m), sampled every ``SAMPLE_M``, in one call."""
+    if len(pairs) == 0:
+        return np.zeros(0)
+    a, b = grid[pairs[:, 0]], grid[pairs[:, 1]]
+    counts = np.maximum(2, np.ceil(np.hypot(*(b - a).T) / SAMPLE_M).astype(np.int64) + 1)
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    owner = np.repeat(np.arange(len(pairs)), counts)
+    t = (np.arange(counts.sum()) - starts[owner]) / (counts[owner] - 1)
+    points = a[owner] + t[:, None] * (b - a)[owner]
+    least: FloatArray = np.minimum.reduceat(world.clearance(points), starts)
     return least
 
 

@@ -1,13 +1,10 @@
 """The study runner: validation, executors (local and a real Dask cluster), resume."""
 
 import io
-import json
-import os
 import signal
 import subprocess
 import sys
 import time
-from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
@@ -19,6 +16,7 @@ from cosim.errors import ConfigError
 from cosim.studies import load_study, run_study
 from cosim.studies.runner import Progress
 from cosim.studies.worker import VOLATILE_METRICS, Outcome
+from tests.dask_cluster import dask_cluster as start_dask_cluster
 
 TINY = """
 [study]
@@ -74,76 +72,11 @@ def test_results_are_identical_in_process_and_on_two_local_workers(tmp_path):
     assert (tmp_path / "two" / "runs" / "0003_s2" / "summary.json").exists()
 
 
-@dataclass
-class DaskCluster:
-    address: str
-    workers: list[subprocess.Popen[bytes]]  # the `dask worker` commands (nanny processes)
-
-
 @pytest.fixture
 def dask_cluster(tmp_path):
     """A real Dask scheduler and two workers, separate processes on loopback."""
-    bin_dir = Path(sys.executable).parent
-    scheduler_file = tmp_path / "scheduler.json"
-    env = {**os.environ, "DASK_DISTRIBUTED__WORKER__DAEMON": "False"}
-    procs = [
-        subprocess.Popen(
-            [
-                str(bin_dir / "dask"),
-                "scheduler",
-                "--host",
-                "127.0.0.1",
-                "--port",
-                "0",
-                "--no-dashboard",
-                "--scheduler-file",
-                str(scheduler_file),
-            ],
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.DEVNULL,
-            env=env,
-        )
-    ]
-    try:
-        deadline = time.monotonic() + 60
-        while not scheduler_file.exists() and time.monotonic() < deadline:
-            time.sleep(0.2)
-        assert scheduler_file.exists(), "dask scheduler did not start"
-        for _ in range(2):
-            procs.append(
-                subprocess.Popen(
-                    [
-                        str(bin_dir / "dask"),
-                        "worker",
-                        "--scheduler-file",
-                        str(scheduler_file),
-                        "--nworkers",
-                        "1",
-                        "--nthreads",
-                        "1",
-                        "--no-dashboard",
-                        "--host",
-                        "127.0.0.1",
-                    ],
-                    stdout=subprocess.DEVNULL,
-                    stderr=subprocess.DEVNULL,
-                    env=env,
-                )
-            )
-        address = json.loads(scheduler_file.read_text())["address"]
-        from distributed import Client
-
-        with Client(address, timeout="30s") as client:
-            client.wait_for_workers(2, timeout=60)
-        yield DaskCluster(address, procs[1:])
-    finally:
-        for proc in reversed(procs):
-            proc.terminate()
-        for proc in procs:
-            try:
-                proc.wait(timeout=20)
-            except subprocess.TimeoutExpired:
-                proc.kill()
+    with start_dask_cluster(tmp_path) as cluster:
+        yield cluster
 
 
 @pytest.mark.slow

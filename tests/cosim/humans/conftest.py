@@ -2,24 +2,16 @@ import numpy as np
 import pytest
 
 import cosim
-from adapters.world.warehouse import warehouse_spec
 from cosim.humans.files import TrafficTypes, write_config, write_demand, write_network
+from cosim.worldfiles import scenario_warehouse
 from models.humans.aisles import aisle_graph, dock_points, pick_stations
 from models.humans.demand import plans
-from models.world import generate_warehouse
 
 TYPES = TrafficTypes(0.5, 1.2, 0.66, 1.0, 2.3, 1.1, 2.2)
 
 
 def warehouse(preset="warehouse-rows"):
-    scenario = cosim.load_scenario(preset)
-
-    class Run:
-        pass
-
-    run = Run()
-    run.scenario = scenario
-    return generate_warehouse(warehouse_spec(run), np.random.default_rng(1))
+    return scenario_warehouse(cosim.load_scenario(preset))
 
 
 @pytest.fixture

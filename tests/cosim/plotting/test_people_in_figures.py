@@ -165,3 +165,31 @@ def test_a_snapshot_shows_everyone_at_the_latest_sample_before_its_time(people_r
     assert len(rows) == 4
     people, forklifts = layer.show(5.05)
     assert len(people.get_paths()) == 3 and len(forklifts.get_paths()) == 1
+
+
+def test_the_redrawn_lidar_beams_stop_at_people_as_the_run_s_lidar_did(people_run):
+    from cosim.plotting.people import PeopleSamples
+    from cosim.plotting.rays import LidarRays
+    from models.kinematics import wrap_angle
+
+    samples = PeopleSamples(people_run)
+    track = people_run.track
+    checked = 0
+    for robot in range(len(track.robots)):
+        rays = LidarRays(people_run, robot, max_rays=360)
+        for i in range(0, len(track.t_s), 10):
+            origin, ends, _ = rays.cast(i)
+            discs = samples.discs(float(track.t_s[i]))
+            if not len(ends) or not len(discs):
+                continue
+            reach = np.hypot(*(ends - origin).T)
+            for x, y, r in discs:
+                gap = np.hypot(x - origin[0], y - origin[1])
+                if not r + 0.5 < gap < rays.range_max_m - 1:
+                    continue
+                bearings = np.arctan2(ends[:, 1] - origin[1], ends[:, 0] - origin[0])
+                toward = np.arctan2(y - origin[1], x - origin[0])
+                beam = int(np.argmin(np.abs(wrap_angle(bearings - toward))))
+                assert reach[beam] <= gap - r + 0.05  # stopped at (or before) the person
+                checked += 1
+    assert checked > 0

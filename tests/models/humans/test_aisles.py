@@ -4,7 +4,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import cosim
-from adapters.world.warehouse import warehouse_spec
+from cosim.worldfiles import scenario_warehouse
 from models.errors import ModelError
 from models.humans.aisles import SAMPLE_M, aisle_graph, dock_points, pick_stations
 from models.layout import WarehouseSpec
@@ -12,14 +12,7 @@ from models.world import box_distance, generate_warehouse
 
 
 def _world(preset, **overrides):
-    scenario = cosim.load_scenario(preset, overrides)
-
-    class Run:  # what warehouse_spec reads
-        pass
-
-    run = Run()
-    run.scenario = scenario
-    return generate_warehouse(warehouse_spec(run), np.random.default_rng(scenario.seed))
+    return scenario_warehouse(cosim.load_scenario(preset, overrides))
 
 
 def _sampled(graph):

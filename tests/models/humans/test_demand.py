@@ -1,21 +1,13 @@
 import numpy as np
 
 import cosim
-from adapters.world.warehouse import warehouse_spec
+from cosim.worldfiles import scenario_warehouse
 from models.humans.aisles import aisle_graph, dock_points, pick_stations
 from models.humans.demand import plans, standing_plans
-from models.world import generate_warehouse
 
 
 def _graph():
-    scenario = cosim.load_scenario("warehouse-rows")
-
-    class Run:
-        pass
-
-    run = Run()
-    run.scenario = scenario
-    world = generate_warehouse(warehouse_spec(run), np.random.default_rng(1))
+    world = scenario_warehouse(cosim.load_scenario("warehouse-rows"))
     graph = aisle_graph(world, clearance_m=0.35, spacing_m=1.5)
     return graph, pick_stations(world, graph, 12, np.random.default_rng(2)), dock_points(graph)
 
