@@ -295,7 +295,12 @@ def _demand(run: RunContext, graph: AisleGraph, stations: Spots, docks: Spots) -
             rng=rng,
         )
     standing = np.array(cfg.standing, dtype=float).reshape(-1, 2)
-    return demand + standing_plans(graph, standing, duration_s)
+    try:
+        return demand + standing_plans(graph, standing, duration_s)
+    except ModelError as error:
+        raise ScenarioError(
+            f"{run.scenario.source}: {error.key} = {error.value!r}: expected {error.expected}"
+        ) from None
 
 
 def _graph(run: RunContext, world: Warehouse) -> tuple[AisleGraph, Spots, Spots]:

@@ -14,6 +14,7 @@ from typing import Literal
 import numpy as np
 
 from models.arrays import FloatArray
+from models.errors import ModelError
 from models.humans.aisles import AisleGraph, IntArray
 
 DOCK_RETURN = 0.3
@@ -135,11 +136,28 @@ def _stages(
     return tuple(stages)
 
 
+STANDING_REACH_M = 2.0
+"""A standing worker's point may lie at most this far from an aisle line (m)."""
+
+
 def standing_plans(graph: AisleGraph, points: FloatArray, duration_s: float) -> list[Plan]:
-    """Workers who stand, from the start, at the aisle spots nearest ``points`` (n, 2)."""
+    """Workers who stand, from the start, at the aisle spots nearest ``points`` (n, 2).
+
+    Raises:
+        ModelError: on ``humans.standing[i]`` for a point further than ``STANDING_REACH_M``
+            from every aisle (outside the room, inside a shelf block): it would silently
+            become a spot elsewhere.
+    """
     if len(points) == 0:
         return []
-    edges, offsets, _ = graph.nearest(points)
+    edges, offsets, gaps = graph.nearest(points)
+    for i in np.flatnonzero(gaps > STANDING_REACH_M).tolist():
+        raise ModelError(
+            f"humans.standing[{i}]",
+            [float(v) for v in points[i]],
+            f"a point within {STANDING_REACH_M:g} m of an aisle where people walk (the "
+            f"nearest is {gaps[i]:.1f} m away)",
+        )
     return [
         Plan(f"standing_{k}", "worker", 0.0, spot, (Stage(spot, duration_s + 60.0),))
         for k, spot in enumerate(_spots(edges, offsets))

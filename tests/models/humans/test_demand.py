@@ -1,9 +1,13 @@
 import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import cosim
 from cosim.worldfiles import scenario_warehouse
+from models.errors import ModelError
 from models.humans.aisles import aisle_graph, dock_points, pick_stations
-from models.humans.demand import plans, standing_plans
+from models.humans.demand import STANDING_REACH_M, plans, standing_plans
 
 
 def _graph():
@@ -58,3 +62,24 @@ def test_standing_workers_stay_at_the_aisle_spot_nearest_their_point_for_the_who
     assert plan.stages[0].stay_s >= 100.0
     x, y = graph.point(plan.start.edge, plan.start.offset_m)
     assert np.hypot(x - point[0], y - point[1]) < 0.1
+
+
+def test_a_standing_point_far_from_every_aisle_is_refused_naming_it():
+    graph, _, _ = _graph()
+    with pytest.raises(ModelError) as error:
+        standing_plans(graph, np.array([[5.0, 5.0], [-50.0, 5.0]]), 100.0)
+    assert error.value.key == "humans.standing[1]"
+    assert "nearest is 5" in error.value.expected
+
+
+@settings(max_examples=60, deadline=None)
+@given(x=st.floats(-20.0, 50.0), y=st.floats(-20.0, 50.0))
+def test_any_standing_point_stands_within_reach_of_it_or_is_refused(x, y):
+    graph, _, _ = _graph()
+    try:
+        (plan,) = standing_plans(graph, np.array([[x, y]]), 10.0)
+    except ModelError as error:
+        assert error.key == "humans.standing[0]"
+        return
+    px, py = graph.point(plan.start.edge, plan.start.offset_m)
+    assert np.hypot(px - x, py - y) <= STANDING_REACH_M + 1e-9
