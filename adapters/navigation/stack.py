@@ -65,6 +65,7 @@ from models.navigation.planner import (
     prune_path,
     shortest_path_length_m,
 )
+from models.navigation.repair import RepairParams, repair_path
 from models.navigation.traffic import TrafficParams, keep_right, moving_points, speed_caps
 from models.occupancy import OccupancyGrid, ground_truth_grid
 from models.world import Warehouse
@@ -151,6 +152,7 @@ class NavigationAdapter:
         self.radius = radius
         self.rngs = [run.rng.stream(f"navigation/{name}") for name in self.names]
         self.traffic = TrafficParams()
+        self.repair = RepairParams()
         self.recovery = Recovery(n, self.memory, self.limits, radius, self.rngs)
         self.status_topics = [topic(n, "nav/status") for n in self.names]
         self.cmd_topics = [topic(n, "cmd_vel") for n in self.names]
@@ -332,50 +334,87 @@ class NavigationAdapter:
         start = time.perf_counter()
         points, discs = self._obstacles_for_plan(i, now_ns)
         layer = self.layers[i]
-        cost = with_obstacles(layer, points, discs=discs if len(discs) else None)
-        s_cell = layer.world_to_cell(self.pose[i, :2])
-        g_cell = layer.world_to_cell(self.goal[i])
-        result = plan(cost, s_cell, g_cell, resolution_m=layer.resolution_m)
-        detail = ""
-        if not result.found:
-            # as Nav2's "clear costmap" recovery does: plan on the static layer alone, and
-            # leave the robots and people in the way to the local controller
-            detail = "cleared"
-            cost = layer.cost
-            result = plan(cost, s_cell, g_cell, resolution_m=layer.resolution_m)
-        if result.found:
-            cells = prune_path(cost, result.cells)
-            waypoints = path_to_world(layer, cells)
-            waypoints[-1] = self.goal[i]
-            self.paths.set(i, waypoints)
-            # Nav2's planner publishes every plan it makes on `plan` (for tools; nothing here
-            # subscribes)
-            run.bus.publish(
-                self.plan_topics[i], Path(now_ns, "map", waypoints.copy()), self.hosts[i]
-            )
-            # moving things the new path bends around: replan while they may leave
-            shaped = paths_blocked(
-                self.paths,
-                np.full(len(points), i),
-                points,
-                self.radius + self.cfg.inflation_radius_m,
-                len(waypoints),
-            )
-            self.planned_around[i] = bool(shaped[i])
-        plan_ms = (time.perf_counter() - start) * 1e3
-        self.next_plan_ns[i] = now_ns + period_ns(self.cfg.replan_hz)
-        length = result.length_m if result.found else math.nan
+        repair = replan and self.paths.lengths[i] >= 2
+        nothing = np.zeros((0, 2))
+        # with what it sees, then as Nav2's "clear costmap" recovery does on the static
+        # layer alone (leaving the robots and people in the way to the local controller);
+        # each first as a repair of the stretch ahead, then in full
+        route = None
+        for seen, near, detail in ((points, discs, ""), (nothing, np.zeros((0, 3)), "cleared")):
+            route = self._repair(i, layer, seen, near) if repair else None
+            if route is not None:
+                detail = f"{detail} repaired".strip()
+                break
+            route = self._full(i, layer, seen, near)
+            if route is not None:
+                break
+        if route is not None:
+            self._set_path(run, i, now_ns, route[0], points)
+        else:
+            self.next_plan_ns[i] = now_ns + period_ns(self.cfg.replan_hz)
         self.records.row(
             now_ns,
             i,
             "replan" if replan else "plan",
             self.goal[i, 0],
             self.goal[i, 1],
-            path_length_m=length,
-            plan_ms=plan_ms,
-            detail=detail if result.found else "no path",
+            path_length_m=route[1] if route is not None else math.nan,
+            plan_ms=(time.perf_counter() - start) * 1e3,
+            detail=detail if route is not None else "no path",
         )
-        return bool(result.found)
+        return route is not None
+
+    def _repair(
+        self, i: int, layer: StaticCostmap, points: np.ndarray, discs: np.ndarray
+    ) -> tuple[np.ndarray, float] | None:
+        """The path with its stretch ahead replanned in a window, or None."""
+        repaired = repair_path(
+            layer,
+            points,
+            discs if len(discs) else None,
+            self.paths.waypoints(i),
+            int(self.paths.segment[i]),
+            self.pose[i, :2],
+            self.repair,
+        )
+        return None if repaired is None else (repaired.waypoints, repaired.length_m)
+
+    def _full(
+        self, i: int, layer: StaticCostmap, points: np.ndarray, discs: np.ndarray
+    ) -> tuple[np.ndarray, float] | None:
+        """A path from the robot to its goal over the whole map, or None."""
+        cost = with_obstacles(layer, points, discs=discs if len(discs) else None)
+        s_cell = layer.world_to_cell(self.pose[i, :2])
+        g_cell = layer.world_to_cell(self.goal[i])
+        result = plan(cost, s_cell, g_cell, resolution_m=layer.resolution_m)
+        if not result.found:
+            return None
+        waypoints = path_to_world(layer, prune_path(cost, result.cells))
+        waypoints[-1] = self.goal[i]
+        return waypoints, result.length_m
+
+    def _set_path(
+        self,
+        run: RunContext,
+        i: int,
+        now_ns: int,
+        waypoints: np.ndarray,
+        points: np.ndarray,
+    ) -> None:
+        self.paths.set(i, waypoints)
+        # Nav2's planner publishes every plan it makes on `plan` (for tools; nothing here
+        # subscribes)
+        run.bus.publish(self.plan_topics[i], Path(now_ns, "map", waypoints.copy()), self.hosts[i])
+        # moving things the new path bends around: replan while they may leave
+        shaped = paths_blocked(
+            self.paths,
+            np.full(len(points), i),
+            points,
+            self.radius + self.cfg.inflation_radius_m,
+            len(waypoints),
+        )
+        self.planned_around[i] = bool(shaped[i])
+        self.next_plan_ns[i] = now_ns + period_ns(self.cfg.replan_hz)
 
     # -- the control tick -------------------------------------------------------------------
     def _control(self, run: RunContext, now_ns: int) -> None:

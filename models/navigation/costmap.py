@@ -171,7 +171,11 @@ def _stamp_discs_py(
     robot_r: float,
     reach_m: float,
     scaling: float,
+    ox: int,
+    oy: int,
 ) -> None:
+    # ``cost`` is the window of the grid whose cell (0, 0) is the grid's (ox, oy); cell
+    # centres are computed in grid cells, so a window's stamp equals the grid's there
     height, width = cost.shape
     tol = _RADIUS_TOL_M
     for q in range(discs.shape[0]):
@@ -179,10 +183,10 @@ def _stamp_discs_py(
         ccx = math.floor((px - origin_x) / res)
         ccy = math.floor((py - origin_y) / res)
         span = pr + reach_m + res
-        x0 = max(0, math.floor((px - span - origin_x) / res))
-        x1 = min(width - 1, math.floor((px + span - origin_x) / res))
-        y0 = max(0, math.floor((py - span - origin_y) / res))
-        y1 = min(height - 1, math.floor((py + span - origin_y) / res))
+        x0 = max(ox, math.floor((px - span - origin_x) / res))
+        x1 = min(ox + width - 1, math.floor((px + span - origin_x) / res))
+        y0 = max(oy, math.floor((py - span - origin_y) / res))
+        y1 = min(oy + height - 1, math.floor((py + span - origin_y) / res))
         for iy in range(y0, y1 + 1):
             dy = origin_y + (iy + 0.5) * res - py
             for ix in range(x0, x1 + 1):
@@ -197,7 +201,7 @@ def _stamp_discs_py(
                 else:
                     continue
                 if v != 0:
-                    cost[iy, ix] = _combine(cost[iy, ix], np.uint8(v))
+                    cost[iy - oy, ix - ox] = _combine(cost[iy - oy, ix - ox], np.uint8(v))
 
 
 _combine: Any = numba.njit(cache=True)(_combine_py)
@@ -304,6 +308,8 @@ def stamp_discs(
     cost: UInt8Array,
     discs: FloatArray,
     params: CostmapParams | None = None,
+    *,
+    offset: tuple[int, int] = (0, 0),
 ) -> None:
     """Mark discs (other robots from a robots layer) lethal and inflated, in place.
 
@@ -318,6 +324,8 @@ def stamp_discs(
             from :func:`with_obstacles`, never ``static.cost``).
         discs: (m, 3) discs ``x, y, radius`` in ``map`` (m); non-finite rows are skipped.
         params: inflation parameters; ``static.params`` if None.
+        offset: ``(ix, iy)`` of ``cost``'s cell (0, 0) on the grid, when ``cost`` is a
+            window of it (see :func:`with_obstacles`).
     """
     p = static.params if params is None else params
     d = np.ascontiguousarray(discs, dtype=np.float64).reshape(-1, 3)
@@ -330,6 +338,8 @@ def stamp_discs(
         p.robot_radius_m,
         p.inflation_radius_m,
         p.cost_scaling,
+        int(offset[0]),
+        int(offset[1]),
     )
 
 
@@ -339,12 +349,15 @@ def with_obstacles(
     params: CostmapParams | None = None,
     *,
     discs: FloatArray | None = None,
+    window: tuple[int, int, int, int] | None = None,
 ) -> UInt8Array:
     """A copy of the static costs with dynamic obstacles marked lethal and inflated.
 
     The cell holding each point becomes 254 and the inflation kernel is stamped around
     it (maximum with the present cost; unknown cells only take 253 and 254), as Nav2's
-    obstacle layer followed by its inflation layer does.
+    obstacle layer followed by its inflation layer does. With ``window`` only that part
+    of the grid is copied and stamped, cell for cell equal to the same part of the whole
+    grid's result (a local replan on a 100 m x 100 m floor need not copy all of it).
 
     Args:
         static: the static costmap.
@@ -353,23 +366,36 @@ def with_obstacles(
             misses the grid are ignored.
         params: inflation parameters; ``static.params`` (and its precomputed kernel) if None.
         discs: optional (m, 3) discs ``x, y, radius`` (m) stamped by :func:`stamp_discs`.
+        window: optional cells ``(ix0, iy0, ix1, iy1)``, half-open, within the grid.
 
     Returns:
-        (rows, cols) uint8 costs on ``static``'s grid, a new writable array.
+        (rows, cols) uint8 costs on ``static``'s grid (or on the window: row 0 is grid
+        row ``iy0``, column 0 grid column ``ix0``), a new writable array.
+
+    Raises:
+        ModelError: for a window that is empty or not within the grid.
     """
-    cost = static.cost.copy()
+    ix0, iy0, ix1, iy1 = (0, 0, static.width, static.height) if window is None else window
+    if not (0 <= ix0 < ix1 <= static.width and 0 <= iy0 < iy1 <= static.height):
+        raise ModelError(
+            "window",
+            window,
+            f"cells (ix0, iy0, ix1, iy1) within the {static.width}x{static.height} grid",
+        )
+    cost = static.cost[iy0:iy1, ix0:ix1].copy()
     pts = np.asarray(points_xy, dtype=np.float64).reshape(-1, 2)
     pts = pts[np.isfinite(pts).all(axis=1)]
     if len(pts):
         origin = np.asarray(static.origin_xy_m, dtype=np.float64)
         cells = np.floor((pts - origin) / static.resolution_m).astype(np.int64)
+        cells -= np.array([ix0, iy0], dtype=np.int64)
         kernel = static.kernel
         if params is not None and params != static.params:
             kernel = inflation_kernel(params, static.resolution_m)
             kernel.setflags(write=False)  # the type the kernel was compiled for
         _stamp_points(cost, cells, kernel)
     if discs is not None:
-        stamp_discs(static, cost, discs, params)
+        stamp_discs(static, cost, discs, params, offset=(ix0, iy0))
     return cost
 
 

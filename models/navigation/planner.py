@@ -97,7 +97,10 @@ def plan(
     sx, sy = _check_cell("start_cell", start_cell, grid)
     gx, gy = _check_cell("goal_cell", goal_cell, grid)
     escape = int(escape_r2(grid, sx, sy, int(lethal)))
-    if escape < 0:
+    goal_blocked = grid[gy, gx] >= lethal and (gx - sx) ** 2 + (gy - sy) ** 2 > escape
+    if escape < 0 or goal_blocked:
+        # no way out, or a goal no path may enter: known without searching (a search
+        # would close every reachable cell first: 10^6 on a 100 m x 100 m floor)
         return PlanResult(False, np.zeros((0, 2), dtype=np.int64), math.inf, math.inf, 0)
     found, cells, straight, diagonal, cost_cells, expansions = astar(
         grid, sx, sy, gx, gy, float(cost_weight), int(lethal), escape, DX, DY
