@@ -11,7 +11,7 @@ STUDY = $(BIN)/cosim study studies/$(1).toml --out $(STUDIES)/$(1) --resume
 
 .PHONY: setup demo test lint bench clean help reproduce study-comm study-comm-reduced \
 	study-burst study-scale study-paper study-nav study-mapping study-mapping-reduced map-aces \
-	lab-real lab-mixed study-humans study-humans-reduced
+	lab-real lab-mixed study-humans study-humans-reduced study-traffic
 
 help:  ## list the targets
 	@grep -E '^[a-z-]+:.*##' $(MAKEFILE_LIST) | sed 's/:.*## /\t/'
@@ -73,6 +73,9 @@ study-mapping: setup  ## map sharing: bandwidth x loss x share mode, 5 seeds x 3
 
 study-mapping-reduced: setup  ## map sharing reduced to 12 runs x 120 s
 	$(call STUDY,map_sharing_reduced)
+
+study-traffic: setup  ## traffic policies 'none' vs 'lanes' x 25/50 robots, 3 seeds x 300 s (about 6 min)
+	$(call STUDY,traffic)
 
 study-humans: setup  ## robots among 0-20 SUMO-driven workers, 5 seeds x 300 s (about 3 min)
 	$(call STUDY,humans)

@@ -57,6 +57,7 @@ from models.mapping.se2 import compose
 from models.navigation.costmap import CostmapParams, StaticCostmap, with_obstacles
 from models.navigation.dwa import DwaParams, dwa_batch
 from models.navigation.follow import PathBook, paths_blocked
+from models.navigation.lanes import TWO_WAY, aisle_lanes
 from models.navigation.planner import (
     GoalStatus,
     goal_status,
@@ -67,7 +68,7 @@ from models.navigation.planner import (
 )
 from models.navigation.repair import RepairParams, repair_path
 from models.navigation.traffic import TrafficParams, keep_right, moving_points, speed_caps
-from models.occupancy import OccupancyGrid, ground_truth_grid
+from models.occupancy import OCCUPIED, OccupancyGrid, ground_truth_grid
 from models.world import Warehouse
 
 ROBOT_STATES = "/fleet/robot_states"
@@ -77,6 +78,12 @@ PATH_CLEARANCE_M = 0.3
 """A moving thing closer than footprint plus this to the path ahead calls for a replan (m)."""
 HALT_MPS = 0.02
 """Commanded speed below which a robot with a goal counts as halted (m/s)..."""
+REPAIR_DETOUR_M = 2.0
+"""A repair lengthening the way by more than this is checked against a full replan (m)."""
+LANE_WIDTH_M = 2.5
+"""``traffic = "lanes"``: aisles up to this wide are one-way (m); two robots pass in wider."""
+LANE_AGAINST = 5.0
+"""``traffic = "lanes"``: a step against an aisle's direction costs this many times more."""
 HALT_RADPS = 0.05
 """...when it does not turn faster than this either (rad/s)."""
 
@@ -115,7 +122,6 @@ class NavigationAdapter:
             run.provide(StaticLayer(ground_truth_grid(run.service(Warehouse), cfg.resolution_m)))
         self.params = CostmapParams(radius, cfg.inflation_radius_m, cfg.cost_scaling)
         self.static = StaticCostmap.from_grid(run.service(StaticLayer).grid, self.params)
-        run.provide(self.static)
         self.mapping = run.scenario.mapping.enabled
         if self.mapping:
             area = map_geometry(run.service(Warehouse), run.scenario.mapping.resolution_m)
@@ -124,6 +130,18 @@ class NavigationAdapter:
             )
         else:
             self.layers = StaticLayers.shared(self.static, len(self.names))
+        self.lanes: np.ndarray | None = None
+        if cfg.traffic == "lanes":
+            # drawn on the building's map by the fleet manager, as Open-RMF's lanes are
+            truth = ground_truth_grid(run.service(Warehouse), cfg.resolution_m)
+            self.lanes = aisle_lanes(truth.data >= OCCUPIED, cfg.resolution_m, LANE_WIDTH_M)
+            if self.lanes.shape != self.layers[0].cost.shape:
+                raise ConfigError(
+                    f"{run.scenario.source}: [navigation] traffic = 'lanes': the lanes' grid "
+                    f"{self.lanes.shape} does not match the costmap's "
+                    f"{self.layers[0].cost.shape}; expected traffic = 'none' with this map"
+                )
+        run.provide(self.static)
         self.measured = MeasuredPoses(run, self.names)
         """Robots localizing by motion capture (or their own reported pose)."""
         self.correction = [(0.0, 0.0, 0.0)] * len(self.names)
@@ -322,6 +340,17 @@ class NavigationAdapter:
         res = self.layers.resolution_m
         points = self.moving.recall(i, res)
         points = points[~self.memory.seen_through(i, points, 2 * res)]
+        if self.lanes is not None and len(points):
+            # in a one-way aisle whatever moves goes the robot's way: it is traffic to
+            # follow (the local controller keeps the distance), not a wall to plan round
+            origin = np.asarray(self.layers.origin_xy_m)
+            cells = np.floor((points - origin) / res).astype(np.int64)
+            rows, cols = self.lanes.shape
+            inside = (cells[:, 0] >= 0) & (cells[:, 0] < cols) & (cells[:, 1] >= 0)
+            inside &= cells[:, 1] < rows
+            in_lane = np.zeros(len(points), dtype=bool)
+            in_lane[inside] = self.lanes[cells[inside, 1], cells[inside, 0]] != TWO_WAY
+            points = points[~in_lane]
         discs = self._discs(i, now_ns)
         return points, discs
 
@@ -334,18 +363,25 @@ class NavigationAdapter:
         start = time.perf_counter()
         points, discs = self._obstacles_for_plan(i, now_ns)
         layer = self.layers[i]
-        repair = replan and self.paths.lengths[i] >= 2
+        # a robot mapping as it goes plans in full: the rest of its old path was planned on
+        # an older map, through space that may since have turned out to be wall
+        repair = replan and not self.mapping and self.paths.lengths[i] >= 2
         nothing = np.zeros((0, 2))
         # with what it sees, then as Nav2's "clear costmap" recovery does on the static
         # layer alone (leaving the robots and people in the way to the local controller);
-        # each first as a repair of the stretch ahead, then in full
+        # each first as a repair of the stretch ahead, then in full; a repair that makes
+        # the way much longer than it was is checked against a full replan (another aisle
+        # may be shorter than the detour round a jam)
         route = None
+        was = float(self.paths.follow_one(i, self.pose[i, 0], self.pose[i, 1])) if repair else 0.0
         for seen, near, detail in ((points, discs, ""), (nothing, np.zeros((0, 3)), "cleared")):
             route = self._repair(i, layer, seen, near) if repair else None
-            if route is not None:
+            if route is not None and route[1] <= was + REPAIR_DETOUR_M:
                 detail = f"{detail} repaired".strip()
                 break
-            route = self._full(i, layer, seen, near)
+            repaired, route = route, self._full(i, layer, seen, near)
+            if route is None and repaired is not None:
+                route, detail = repaired, f"{detail} repaired".strip()
             if route is not None:
                 break
         if route is not None:
@@ -376,6 +412,8 @@ class NavigationAdapter:
             int(self.paths.segment[i]),
             self.pose[i, :2],
             self.repair,
+            lanes=self.lanes,
+            against=LANE_AGAINST,
         )
         return None if repaired is None else (repaired.waypoints, repaired.length_m)
 
@@ -386,7 +424,14 @@ class NavigationAdapter:
         cost = with_obstacles(layer, points, discs=discs if len(discs) else None)
         s_cell = layer.world_to_cell(self.pose[i, :2])
         g_cell = layer.world_to_cell(self.goal[i])
-        result = plan(cost, s_cell, g_cell, resolution_m=layer.resolution_m)
+        result = plan(
+            cost,
+            s_cell,
+            g_cell,
+            resolution_m=layer.resolution_m,
+            lanes=self.lanes,
+            against=LANE_AGAINST,
+        )
         if not result.found:
             return None
         waypoints = path_to_world(layer, prune_path(cost, result.cells))

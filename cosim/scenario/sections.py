@@ -198,6 +198,12 @@ class NavigationConfig:
         gt=0,
     )
     progress_hz: float = param(1.0, "rate of `progress` status reports (Hz)", gt=0, le=1000)
+    traffic: Literal["none", "lanes"] = param(
+        "none",
+        "fleet traffic policy: 'lanes' makes aisles up to 2.5 m wide one-way, neighbours "
+        "in opposite directions (the planner charges 5x for a step against one); 'none': "
+        "every robot plans for itself",
+    )
     goals: tuple[tuple[float, float], ...] = param(
         (),
         "driver 'navigation': a series of goals [[x_m, y_m], ...] in map, visited in order "

@@ -149,6 +149,26 @@ class PathBook:
         )
         return carrots, remaining
 
+    def follow_one(self, robot: int, x_m: float, y_m: float) -> float:
+        """The remaining length (m) of ``robot``'s path from ``(x_m, y_m)``, as :meth:`follow`.
+
+        Does not move the robot's projection along its path.
+        """
+        one = slice(robot, robot + 1)
+        carrots = np.zeros((1, 2))
+        remaining = np.zeros(1)
+        _follow(
+            self.paths[one],
+            self.lengths[one],
+            self.segment[one].copy(),
+            np.array([x_m]),
+            np.array([y_m]),
+            0.0,
+            carrots,
+            remaining,
+        )
+        return float(remaining[0])
+
 
 def _blocking_py(
     paths: FloatArray,

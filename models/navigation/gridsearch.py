@@ -83,6 +83,8 @@ def _astar_py(
     escape_r2: int,
     dxs: IntArray,
     dys: IntArray,
+    lanes: UInt8Array,
+    against: float,
 ) -> tuple[bool, IntArray, int, int, float, int]:
     """A* with an indexed binary heap (decrease-key) ordered by ``(f, -g)``.
 
@@ -93,12 +95,18 @@ def _astar_py(
     ``heap_k[2i] = f``, ``heap_k[2i + 1] = g`` (side by side for locality) and
     ``heap_n[i]`` = cell; the heap starts small and doubles when full.
 
+    ``lanes`` (rows, cols) one-way directions (:mod:`models.navigation.lanes`) or an
+    empty (0, 0) array: a step whose move runs against the lane of the cell it enters
+    costs ``against`` times more.
+
     Returns found, the path cells (n, 2), its straight and diagonal step counts, its
     cost in cells, and the number of expansions.
     """
     height, width = cost.shape
     n = width * height
     grid = cost.ravel()
+    lane = lanes.ravel()
+    use_lanes = lane.shape[0] == n
     offsets = dys * width + dxs
     buf = np.zeros(n + (5 * n + 7) // 8)
     g = buf[:n]
@@ -186,7 +194,17 @@ def _astar_py(
                 if grid[node + dys[k] * width] >= lethal and not _escapes(x, ny, sx, sy, escape_r2):
                     continue
                 step = SQRT2
-            ng = node_g + step * (1.0 + scale * c_nb)
+            step *= 1.0 + scale * c_nb
+            if use_lanes:
+                d = lane[nb]
+                if (
+                    (d == 1 and dxs[k] < 0)
+                    or (d == 2 and dxs[k] > 0)
+                    or (d == 3 and dys[k] < 0)
+                    or (d == 4 and dys[k] > 0)
+                ):
+                    step *= against
+            ng = node_g + step
             if slot > 0 and ng >= g[nb]:
                 continue
             g[nb] = ng

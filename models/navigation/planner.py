@@ -34,6 +34,8 @@ from models.errors import ModelError
 from models.navigation.costmap import INSCRIBED, NO_INFORMATION, StaticCostmap
 from models.navigation.gridsearch import DX, DY, SQRT2, astar, escape_r2, prune, readonly
 
+_NO_LANES = readonly(np.zeros((0, 0), dtype=np.uint8))
+
 
 @dataclass(frozen=True, eq=False)
 class PlanResult:
@@ -71,6 +73,8 @@ def plan(
     cost_weight: float = 1.0,
     lethal: int = INSCRIBED,
     resolution_m: float = 1.0,
+    lanes: UInt8Array | None = None,
+    against: float = 1.0,
 ) -> PlanResult:
     """A least-cost path between two cells of a cost grid (A*, 8-connected).
 
@@ -87,12 +91,25 @@ def plan(
             centre may not touch anything; 254: it may, as long as it is not in an
             obstacle cell).
         resolution_m: cell edge length (m) for ``length_m`` and ``cost_m``.
+        lanes: optional (rows, cols) one-way directions of the cells
+            (:func:`models.navigation.lanes.aisle_lanes`), same shape as ``cost``.
+        against: a step against the lane of the cell it enters costs this many times
+            more (>= 1; steps only get dearer, so the heuristic stays admissible).
 
     Raises:
-        ModelError: for a start or goal outside the grid or a negative weight.
+        ModelError: for a start or goal outside the grid, a negative weight, lanes of
+            another shape or ``against`` below 1.
     """
     if not (math.isfinite(cost_weight) and cost_weight >= 0):
         raise ModelError("cost_weight", cost_weight, "a finite weight >= 0")
+    if not (math.isfinite(against) and against >= 1):
+        raise ModelError("against", against, "a finite factor >= 1")
+    if lanes is None:
+        lane_grid = _NO_LANES
+    else:
+        lane_grid = readonly(np.ascontiguousarray(lanes, dtype=np.uint8))
+        if lane_grid.shape != np.shape(cost):
+            raise ModelError("lanes", lane_grid.shape, f"the cost grid's shape {np.shape(cost)}")
     grid = readonly(np.ascontiguousarray(cost, dtype=np.uint8))
     sx, sy = _check_cell("start_cell", start_cell, grid)
     gx, gy = _check_cell("goal_cell", goal_cell, grid)
@@ -103,7 +120,18 @@ def plan(
         # would close every reachable cell first: 10^6 on a 100 m x 100 m floor)
         return PlanResult(False, np.zeros((0, 2), dtype=np.int64), math.inf, math.inf, 0)
     found, cells, straight, diagonal, cost_cells, expansions = astar(
-        grid, sx, sy, gx, gy, float(cost_weight), int(lethal), escape, DX, DY
+        grid,
+        sx,
+        sy,
+        gx,
+        gy,
+        float(cost_weight),
+        int(lethal),
+        escape,
+        DX,
+        DY,
+        lane_grid,
+        float(against),
     )
     if not found:
         return PlanResult(False, cells, math.inf, math.inf, int(expansions))

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from models.arrays import FloatArray
+from models.arrays import FloatArray, UInt8Array
 from models.errors import ModelError
 from models.navigation.costmap import StaticCostmap, with_obstacles
 from models.navigation.planner import plan, prune_path
@@ -105,6 +105,9 @@ def repair_path(
     segment: int,
     start_xy: FloatArray,
     params: RepairParams,
+    *,
+    lanes: UInt8Array | None = None,
+    against: float = 1.0,
 ) -> Repair | None:
     """Replan the stretch of a path ahead of the robot inside a window around it.
 
@@ -116,6 +119,9 @@ def repair_path(
         segment: the segment of the path the robot is on.
         start_xy: the robot's position (m).
         params: the repair's reach.
+        lanes: optional one-way directions of the grid's cells, as for
+            :func:`models.navigation.planner.plan`.
+        against: cost factor of a step against a lane.
 
     Returns:
         The repaired path, or None when no path inside the window reaches the cut point
@@ -137,7 +143,8 @@ def repair_path(
     window = (ix0, iy0, ix1, iy1)
     cost = with_obstacles(static, points_xy, discs=discs, window=window)
     local = (s_cell[0] - ix0, s_cell[1] - iy0), (g_cell[0] - ix0, g_cell[1] - iy0)
-    result = plan(cost, local[0], local[1], resolution_m=res)
+    window_lanes = None if lanes is None else lanes[iy0:iy1, ix0:ix1]
+    result = plan(cost, local[0], local[1], resolution_m=res, lanes=window_lanes, against=against)
     if not result.found:
         return None
     cells = prune_path(cost, result.cells) + np.array([ix0, iy0])
