@@ -233,3 +233,26 @@ def test_progress_is_reported_while_driving():
     progress = [t for t, name, state, _ in GoalScript.statuses if state == "progress"]
     assert len(progress) >= 5
     assert np.allclose(np.diff(progress), 1.0)
+
+
+def test_with_one_way_lanes_robots_reach_goals_without_collision_and_repair_their_paths():
+    scenario = cosim.load_scenario(
+        "fleet50",
+        {
+            "navigation.traffic": "lanes",
+            "robots.count": 12,
+            "scenario.duration_s": 40.0,
+            "record.bag": "none",
+        },
+    )
+    result = cosim.run(scenario)
+    assert result.summary["collisions"] == 0
+    assert result.summary["arrivals"] > 0
+    details = set(result.tables["navigation"].query("event == 'replan'")["detail"])
+    assert "repaired" in details
+
+
+def test_an_unknown_traffic_policy_is_refused_naming_the_key_and_the_choices():
+    expected = r"\[navigation\] traffic = 'roundabouts': expected one of 'none', 'lanes'"
+    with pytest.raises(cosim.ConfigError, match=expected):
+        cosim.load_scenario("fleet50", {"navigation.traffic": "roundabouts"})
