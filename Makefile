@@ -62,7 +62,7 @@ study-comm-reduced: setup  ## the comm sweep reduced to 81 runs
 study-burst: setup  ## Gilbert-Elliott vs Bernoulli loss at equal mean loss
 	$(call STUDY,burst_vs_iid)
 
-study-scale: setup  ## 4 to 200 robots: wall time, real-time factor, messages
+study-scale: setup  ## 4 to 1,000 robots: wall time, real-time factor, wall per robot-second (log-log), 3 seeds x 60 s
 	$(call STUDY,scale)
 
 study-paper: setup  ## the paper's Scenario 1, random shelves and racks

@@ -16,6 +16,8 @@ from mapping_bench import aces_mapping, fleet50_mapping, per_scan_costs
 from network_bench import network_deliveries_per_second
 from planner_bench import planner_ms
 from recording_bench import bag_cost, bag_memory_1h, encoding
+from scale_bench import fleet_scaling
+from study_bench import study_throughput_200
 
 import cosim
 from cosim.adapter import RunContext
@@ -332,9 +334,11 @@ SUITES: dict[str, Callable[[int], Result]] = {
     "dwa": dwa_us_per_robot,
     "assignment": assignment_solve_stats,
     "study": study_throughput,
+    "study_throughput_200": study_throughput_200,
     "fleet50_physics": fleet50_physics,
     "fleet50_wander": fleet50_wander,
     "fleet1000_wander": fleet1000_wander,
+    "fleet_scaling": fleet_scaling,
     "bag_cost": bag_cost,
     "bag_memory_1h": bag_memory_1h,
     "cdr_encoding": encoding,

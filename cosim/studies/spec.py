@@ -25,6 +25,7 @@ hue = "assignment.protocol"
 facet = "network.loss_prob"
 metrics = ["tasks_per_min", "optimality_gap"]
 heatmaps = ["tasks_per_min"]       # optional: x by facet, a panel per hue value
+loglog = ["wall_us_per_robot_s"]  # optional: also drawn on log-log axes (x values > 0)
 ```
 
 Every combination is loaded as a scenario before the study starts, so a bad key or value in
@@ -48,7 +49,7 @@ from cosim.scenario.tomlfile import read_toml_file
 
 SECTIONS = ("study", "grid", "overrides", "cases", "report")
 STUDY_KEYS = ("name", "scenario", "seeds", "duration_s", "tables", "description")
-REPORT_KEYS = ("x", "hue", "facet", "metrics", "heatmaps", "timeseries")
+REPORT_KEYS = ("x", "hue", "facet", "metrics", "heatmaps", "loglog", "timeseries")
 TIMESERIES_KEYS = ("table", "y", "where")
 
 
@@ -81,7 +82,8 @@ class StudySpec:
         grid: key -> values crossed.
         overrides: keys set in every run.
         cases: explicit combinations crossed with the grid.
-        report: the ``[report]`` section (x, hue, facet, metrics, heatmaps).
+        report: the ``[report]`` section (x, hue, facet, metrics, heatmaps, loglog,
+            timeseries).
         description: free text for the report.
     """
 
@@ -268,12 +270,42 @@ def _check_report(
                 f"{key} = {value!r}: not a key this study sets (expected one of "
                 f"{', '.join(sorted(study_keys)) or 'none'}, or a summary metric)",
             )
-    for key in ("metrics", "heatmaps"):
+    for key in ("metrics", "heatmaps", "loglog"):
         value = report.get(key, [])
         if not isinstance(value, list) or not all(isinstance(m, str) and m for m in value):
             raise _fail(path, "report", f"{key} = {value!r}: expected a list of metric names")
     if report.get("heatmaps") and not ("x" in report and "facet" in report):
         raise _fail(path, "report", "heatmaps need x and facet (the heatmap's columns and rows)")
+    if report.get("loglog"):
+        _check_loglog_x(path, report, grid, overrides, cases)
+
+
+def _check_loglog_x(
+    path: Path,
+    report: dict[str, Any],
+    grid: dict[str, Any],
+    overrides: dict[str, Any],
+    cases: tuple[dict[str, Any], ...],
+) -> None:
+    """Log-log figures need an x whose values the study sets to be numbers > 0.
+
+    An undotted x is a summary metric, checked when the report is drawn.
+    """
+    loglog = report["loglog"]
+    if "x" not in report:
+        raise _fail(path, "report", f"loglog = {loglog!r}: needs x (the horizontal log axis)")
+    x = report["x"]
+    places = [("grid", v) for v in grid.get(x, [])]
+    places += [("overrides", overrides[x])] if x in overrides else []
+    places += [(f"cases[{i}]", case[x]) for i, case in enumerate(cases) if x in case]
+    for where, value in places:
+        if isinstance(value, bool) or not isinstance(value, int | float) or value <= 0:
+            raise _fail(
+                path,
+                "report",
+                f"loglog = {loglog!r}: x = {x!r} is {value!r} in [{where}]; "
+                "expected numbers > 0 on a log axis",
+            )
 
 
 def _check_timeseries(path: Path, entries: Any, tables: tuple[str, ...]) -> None:
