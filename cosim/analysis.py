@@ -166,7 +166,7 @@ def plot_metric(
     figure = metric_figure(
         results, x, metric, hue=hue, facet=facet, title=title, confidence=confidence, logx=logx
     )
-    return _save(figure, Path(out))
+    return save_figure(figure, Path(out))
 
 
 def heatmap(
@@ -204,7 +204,7 @@ def heatmap(
     _label_axes(axes, x, y)
     figure.colorbar(image, ax=axes, label=f"{metric} (mean over seeds)")
     figure.suptitle(title or f"{metric} over {x} and {y}")
-    return _save(figure, Path(out))
+    return save_figure(figure, Path(out))
 
 
 def markdown_table(frame: pd.DataFrame, floatfmt: str = ".3g") -> str:
@@ -370,7 +370,8 @@ def _label_axes(axes: list[Axes], x: str, y: str) -> None:
             ax.set_ylabel(y)
 
 
-def _save(figure: Figure, path: Path) -> Path:
+def save_figure(figure: Figure, path: Path) -> Path:
+    """Write a figure as PNG (Agg, without pyplot), making its folder; ExportError if not."""
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         FigureCanvasAgg(figure)  # attaches itself: savefig renders with Agg, not pyplot

@@ -133,14 +133,9 @@ class NavigationAdapter:
         self.lanes: np.ndarray | None = None
         if cfg.traffic == "lanes":
             # drawn on the building's map by the fleet manager, as Open-RMF's lanes are
-            truth = ground_truth_grid(run.service(Warehouse), cfg.resolution_m)
-            self.lanes = aisle_lanes(truth.data >= OCCUPIED, cfg.resolution_m, LANE_WIDTH_M)
-            if self.lanes.shape != self.layers[0].cost.shape:
-                raise ConfigError(
-                    f"{run.scenario.source}: [navigation] traffic = 'lanes': the lanes' grid "
-                    f"{self.lanes.shape} does not match the costmap's "
-                    f"{self.layers[0].cost.shape}; expected traffic = 'none' with this map"
-                )
+            self.lanes = _lanes_on(
+                self.layers[0], ground_truth_grid(run.service(Warehouse), cfg.resolution_m)
+            )
         run.provide(self.static)
         self.measured = MeasuredPoses(run, self.names)
         """Robots localizing by motion capture (or their own reported pose)."""
@@ -588,6 +583,25 @@ class NavigationAdapter:
         accepted = summary["goals"] - summary["goals_unreachable"]
         summary["goals_missed"] = accepted - summary["arrivals"] - active
         return summary
+
+
+def _lanes_on(layer: StaticCostmap, truth: OccupancyGrid) -> np.ndarray:
+    """The building's one-way lanes on a costmap's cells (two-way where the map reaches past it).
+
+    A robot that maps plans on a grid with a margin around the building; the lanes are laid
+    into it at the building's offset. Both grids share the cell size.
+    """
+    lanes = aisle_lanes(truth.data >= OCCUPIED, truth.resolution_m, LANE_WIDTH_M)
+    offset = np.subtract(truth.origin_xy_m, layer.origin_xy_m) / layer.resolution_m
+    ox, oy = (int(v) for v in np.rint(offset))
+    rows, cols = lanes.shape
+    if ox < 0 or oy < 0 or oy + rows > layer.height or ox + cols > layer.width:
+        raise ValueError(
+            f"the costmap {layer.cost.shape} does not cover the building {lanes.shape}"
+        )
+    placed = np.full(layer.cost.shape, TWO_WAY, dtype=np.uint8)
+    placed[oy : oy + rows, ox : ox + cols] = lanes
+    return placed
 
 
 def _beam_angles(beams: int, fov_rad: float) -> np.ndarray:

@@ -9,17 +9,16 @@ from types import MappingProxyType
 
 import numpy as np
 import pandas as pd
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.ticker import NullLocator
 
 from cosim.analysis import (
-    DPI,
     FIGURES_DIR,
     RESULTS_FILE,
     heatmap,
     load_results,
     metric_figure,
+    save_figure,
     standard_figures,
     write_report,
 )
@@ -191,7 +190,9 @@ def loglog_figures(
         if not usable.any():
             continue
         figure = loglog_figure(ok[usable], x, metric, hue=hue, facet=facet)
-        paths.append(_save(figure, Path(study_dir) / FIGURES_DIR / f"{metric}_vs_{x}_loglog.png"))
+        paths.append(
+            save_figure(figure, Path(study_dir) / FIGURES_DIR / f"{metric}_vs_{x}_loglog.png")
+        )
     return paths, notes
 
 
@@ -216,13 +217,3 @@ def loglog_figure(
             ax.set_xticks(levels, [f"{v:g}" for v in levels])
             ax.xaxis.set_minor_locator(NullLocator())
     return figure
-
-
-def _save(figure: Figure, path: Path) -> Path:
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        FigureCanvasAgg(figure)  # attaches itself: savefig renders with Agg, not pyplot
-        figure.savefig(path, format="png", dpi=DPI)
-    except OSError as error:
-        raise ExportError(f"{path}: cannot write: {error.strerror or error}") from None
-    return path

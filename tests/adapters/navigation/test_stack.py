@@ -256,3 +256,23 @@ def test_an_unknown_traffic_policy_is_refused_naming_the_key_and_the_choices():
     expected = r"\[navigation\] traffic = 'roundabouts': expected one of 'none', 'lanes'"
     with pytest.raises(cosim.ConfigError, match=expected):
         cosim.load_scenario("fleet50", {"navigation.traffic": "roundabouts"})
+
+
+def test_robots_that_map_drive_on_the_buildings_lanes_laid_into_their_wider_maps():
+    from adapters.navigation.stack import _lanes_on
+    from cosim.worldfiles import scenario_warehouse
+    from models.navigation.costmap import CostmapParams, StaticCostmap
+    from models.navigation.lanes import TWO_WAY, aisle_lanes
+    from models.occupancy import OCCUPIED, OccupancyGrid, ground_truth_grid
+
+    scenario = cosim.load_scenario("warehouse-mapping", {"navigation.traffic": "lanes"})
+    truth = ground_truth_grid(scenario_warehouse(scenario), 0.1)
+    margin = np.zeros((truth.data.shape[0] + 20, truth.data.shape[1] + 20), dtype=np.int8)
+    wider = OccupancyGrid(0.1, (truth.origin_xy_m[0] - 1.0, truth.origin_xy_m[1] - 1.0), margin)
+    layer = StaticCostmap.from_grid(wider, CostmapParams(0.3))
+    placed = _lanes_on(layer, truth)
+    assert placed.shape == layer.cost.shape
+    assert np.array_equal(placed[10:-10, 10:-10], aisle_lanes(truth.data >= OCCUPIED, 0.1, 2.5))
+    assert (placed[:10] == TWO_WAY).all() and (placed[:, -10:] == TWO_WAY).all()
+    result = cosim.run(scenario.with_duration(20.0))
+    assert result.summary["collisions"] == 0
