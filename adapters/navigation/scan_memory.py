@@ -108,20 +108,31 @@ class ScanMemory:
 class MovingMemory:
     """Moving things (robots, people) seen by each robot in the last ``memory_ns``.
 
+    Each instant's sightings are kept CSR-packed by robot with their cell keys on the
+    ``cell_m`` grid computed once, so that a recall (one per replan, about 40 a second in
+    ``fleet50``) only slices and deduplicates (it cost 0.3 ms when every recall searched
+    and floored every instant's points again).
+
     Args:
         memory_ns: how long a sighting is kept (ns).
+        cell_m: cell size of the keys computed on arrival (m); a recall on another cell
+            size computes its own.
     """
 
-    def __init__(self, memory_ns: int) -> None:
+    def __init__(self, memory_ns: int, cell_m: float = 0.1) -> None:
         self.memory_ns = memory_ns
-        self._ticks: deque[tuple[int, IntArray, FloatArray]] = deque()
+        self.cell_m = cell_m
+        self._ticks: deque[tuple[int, list[int], IntArray, FloatArray]] = deque()
 
     def remember(self, now_ns: int, owner: IntArray, points: FloatArray) -> None:
         """Keep the sightings of one instant: ``points`` (k, 2) in ``map``, seen by ``owner``.
 
         ``owner`` must be sorted (points grouped by robot), as CSR-packed scans are.
         """
-        self._ticks.append((now_ns, owner, points))
+        owner = np.asarray(owner)
+        top = int(owner[-1]) + 1 if len(owner) else 0
+        bounds = np.searchsorted(owner, np.arange(top + 1)).tolist()
+        self._ticks.append((now_ns, bounds, _cell_keys(points, self.cell_m), points))
         while self._ticks and now_ns - self._ticks[0][0] > self.memory_ns:
             self._ticks.popleft()
 
@@ -132,16 +143,24 @@ class MovingMemory:
             (m, 2) points in ``map`` (m), the first sighting of each cell of a
             ``cell_m`` grid (marking a costmap cell twice changes nothing).
         """
-        parts = []
-        for _, owner, points in self._ticks:
-            lo, hi = np.searchsorted(owner, (robot, robot + 1))
-            if hi > lo:
-                parts.append(points[lo:hi])
+        keys: list[IntArray] = []
+        parts: list[FloatArray] = []
+        for _, bounds, tick_keys, points in self._ticks:
+            if robot + 1 < len(bounds):
+                lo, hi = bounds[robot], bounds[robot + 1]
+                if hi > lo:
+                    keys.append(tick_keys[lo:hi])
+                    parts.append(points[lo:hi])
         if not parts:
             return np.zeros((0, 2))
-        every = np.vstack(parts)
-        cells = np.floor(every / cell_m).astype(np.int64)
-        # one integer key per cell (a 1-D unique is far cheaper than unique rows)
-        keys = (cells[:, 0] << 32) + (cells[:, 1] & 0xFFFFFFFF)
-        _, first = np.unique(keys, return_index=True)
+        every = np.concatenate(parts)
+        every_keys = np.concatenate(keys) if cell_m == self.cell_m else _cell_keys(every, cell_m)
+        _, first = np.unique(every_keys, return_index=True)
         return every[np.sort(first)]
+
+
+def _cell_keys(points: FloatArray, cell_m: float) -> IntArray:
+    """One integer per ``cell_m`` cell of each point (a 1-D unique is far cheaper than rows)."""
+    cells = np.floor(np.asarray(points) / cell_m).astype(np.int64).reshape(-1, 2)
+    keys: IntArray = (cells[:, 0] << 32) + (cells[:, 1] & 0xFFFFFFFF)
+    return keys

@@ -147,7 +147,7 @@ class NavigationAdapter:
         lidar = run.scenario.lidar
         angles = _beam_angles(lidar.beams, math.radians(lidar.fov_deg))
         self.memory = ScanMemory(n, angles, lidar.range_max_m)
-        self.moving = MovingMemory(s_to_ns(cfg.obstacle_memory_s))
+        self.moving = MovingMemory(s_to_ns(cfg.obstacle_memory_s), self.layers.resolution_m)
         self.planned_around = np.zeros(n, dtype=bool)
         self.near_m = self.limits.max_speed_mps * self.dwa.sim_time_s + radius + 1.0
         self.paths = PathBook(n)

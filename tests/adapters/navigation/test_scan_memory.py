@@ -34,3 +34,16 @@ def test_moving_memory_forgets_after_its_span_and_dedups_cells():
     memory.remember(1_200_000_000, np.array([1]), np.array([[6.0, 6.0]]))
     assert len(memory.recall(0, 0.1)) == 1  # the first tick is forgotten, the second kept
     assert memory.recall(1, 0.1) == pytest.approx(np.array([[6.0, 6.0]]))
+
+
+def test_moving_memory_recalls_first_sightings_in_order_on_any_cell_size():
+    memory = MovingMemory(10_000_000_000, cell_m=0.1)
+    memory.remember(0, np.array([0, 0, 2]), np.array([[1.0, 1.0], [2.0, 2.0], [9.0, 9.0]]))
+    memory.remember(1, np.array([0, 0]), np.array([[3.0, 3.0], [1.01, 1.01]]))
+    memory.remember(2, np.array([], dtype=np.int64), np.zeros((0, 2)))
+    # the first sighting of each cell, oldest first; a robot beyond a tick's owners sees none
+    assert memory.recall(0, 0.1) == pytest.approx(np.array([[1.0, 1.0], [2.0, 2.0], [3.0, 3.0]]))
+    assert len(memory.recall(1, 0.1)) == 0
+    assert len(memory.recall(5, 0.1)) == 0
+    # a coarser grid merges cells: the keys are computed for it, not taken from arrival
+    assert memory.recall(0, 2.5) == pytest.approx(np.array([[1.0, 1.0], [3.0, 3.0]]))
