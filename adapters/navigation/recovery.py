@@ -5,6 +5,7 @@ replans, then cycles through the steps of :data:`RECOVERY_STEPS` and replans aga
 wait lasts a random 0.5-2.5 s drawn from the robot's own stream, so two robots halted
 nose to nose do not recover in lockstep and one of them gets going first. It rotates
 towards the side with more room and backs up only if the latest scan shows room behind.
+:class:`StallWatch` finds robots that stand still whatever they command.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import numpy as np
 
 from adapters.navigation.scan_memory import ScanMemory
 from cosim.timebase import s_to_ns
+from models.arrays import BoolArray, FloatArray
 from models.kinematics import DriveLimits
 
 RECOVERY_STEPS = (("wait", 1.0), ("rotate", 1.5), ("back_up", 1.5))
@@ -25,6 +27,49 @@ BACK_UP_ROOM_M = 0.4
 """How far behind its centre a backing robot's footprint must stay clear (m)."""
 BACK_UP_MARGIN_M = 0.15
 """Clearance kept around the swept footprint when backing up (m)."""
+STALL_M = 0.1
+"""A robot with a goal whose pose moves less than this (m)..."""
+STALL_RAD = 0.5
+"""...and turns less than this (rad)..."""
+STALL_S = 2.0
+"""...for this long has stalled, whatever it commands (s)."""
+
+
+class StallWatch:
+    """Robots with a goal that have hardly moved or turned for ``STALL_S``.
+
+    The controller's commands alone miss a livelock seen in ``fleet50``: two robots nose
+    to nose, each turning left and right by turns (0.15 rad/s, above the halt threshold)
+    and never moving, stood for 30 s without a recovery until ``stuck`` gave their goals
+    up. A stalled robot counts as halted, so it recovers (Nav2's progress checker watches
+    the pose in the same way: it must move some distance within a time).
+
+    Args:
+        poses: (n, 3) initial poses ``x, y, yaw`` in ``map`` (m, rad).
+    """
+
+    def __init__(self, poses: FloatArray) -> None:
+        self.anchor = np.array(poses, dtype=float, copy=True)
+        self.since_ns = np.zeros(len(poses), dtype=np.int64)
+
+    def reset(self, i: int, pose: FloatArray, now_ns: int) -> None:
+        """Start watching robot ``i`` afresh from ``pose`` (a new goal)."""
+        self.anchor[i] = pose
+        self.since_ns[i] = now_ns
+
+    def update(self, now_ns: int, poses: FloatArray, active: BoolArray) -> BoolArray:
+        """The robots with a goal stalled at ``now_ns``, given their ``poses`` (n, 3).
+
+        A robot that moved more than ``STALL_M`` or turned more than ``STALL_RAD`` since
+        its anchor, or has no goal, is anchored anew where it is.
+        """
+        turn = np.abs(np.angle(np.exp(1j * (poses[:, 2] - self.anchor[:, 2]))))
+        moved = np.hypot(poses[:, 0] - self.anchor[:, 0], poses[:, 1] - self.anchor[:, 1])
+        fresh = ~active | (moved > STALL_M) | (turn > STALL_RAD)
+        self.anchor[fresh] = poses[fresh]
+        self.since_ns[fresh] = now_ns
+        stalled: BoolArray = now_ns - self.since_ns >= s_to_ns(STALL_S)
+        return stalled
 
 
 class Recovery:

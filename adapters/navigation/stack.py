@@ -31,7 +31,7 @@ from adapters.naming import topic
 from adapters.navigation.layers import StaticLayers
 from adapters.navigation.localization import MeasuredPoses
 from adapters.navigation.records import NavRecords
-from adapters.navigation.recovery import Recovery
+from adapters.navigation.recovery import Recovery, StallWatch
 from adapters.navigation.scan_memory import MovingMemory, ScanMemory
 from cosim.adapter import RunContext
 from cosim.bus import Envelope
@@ -167,6 +167,7 @@ class NavigationAdapter:
         self.traffic = TrafficParams()
         self.repair = RepairParams()
         self.recovery = Recovery(n, self.memory, self.limits, radius, self.rngs)
+        self.stalls = StallWatch(self.pose)
         self.status_topics = [topic(n, "nav/status") for n in self.names]
         self.cmd_topics = [topic(n, "cmd_vel") for n in self.names]
         self.plan_topics = [topic(n, "plan") for n in self.names]
@@ -319,6 +320,7 @@ class NavigationAdapter:
         self.best_remaining[i] = math.inf
         self.progress_ns[i] = now
         self.recovery.reset(i)
+        self.stalls.reset(i, self.pose[i], now)
         self.records.start_goal(i, now, float(self.fleet.distance_m[i]), shortest)
         self._status(run, i, "accepted", shortest)
         self._plan(run, i, now, replan=False)
@@ -516,6 +518,8 @@ class NavigationAdapter:
         # halted: the controller found nothing admissible ahead, or chose to stand still
         # (a robot in the way) while its goal is elsewhere
         halted = result.blocked | ((np.abs(v) < HALT_MPS) & (np.abs(result.w) < HALT_RADPS))
+        # ...or has hardly moved for a while whatever it commanded (dithering nose to nose)
+        halted |= self.stalls.update(now_ns, self.pose, self.active)
         self.recovery.apply(
             now_ns,
             halted,
