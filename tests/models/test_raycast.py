@@ -278,3 +278,32 @@ def test_a_scene_spanning_a_huge_area_still_finds_its_segments():
         5.0,
     )
     assert ranges[0, 0] == pytest.approx(3.0, abs=1e-12)
+
+
+def test_circles_are_binned_in_every_cell_their_padded_box_touches_and_spill_outside_the_grid():
+    rng = np.random.default_rng(11)
+    scene = StaticScene(box_segments(np.array([[0.0, 0.0, 10.0, 10.0]])), cell_m=1.0)
+    gx0, gy0, cell, nx, ny = scene.grid
+    circles = np.column_stack([rng.uniform(-3, 13, (40, 2)), rng.uniform(0.05, 1.5, 40)])
+    circles[0] = [gx0 + 3 * cell, gy0 + 2 * cell, cell]  # a box edge on grid lines
+    circles[1, 0] = np.nan
+    start, data, ids, spilled = scene.bin_circles(circles)
+    pad = 1e-7  # models.raycast._PAD_M
+    lo = circles[:, :2] - (circles[:, 2:] + pad)
+    hi = circles[:, :2] + (circles[:, 2:] + pad)
+    inside = np.all((lo > [gx0, gy0]) & (hi < [gx0 + nx * cell, gy0 + ny * cell]), axis=1)
+    np.testing.assert_array_equal(spilled, np.flatnonzero(~inside))
+    assert 1 in spilled
+    expected = []
+    for c in range(int(nx * ny)):
+        i, j = c % int(nx), c // int(nx)
+        touches = (
+            (np.floor((lo[:, 0] - gx0) / cell) <= i)
+            & (np.floor((hi[:, 0] - gx0) / cell) >= i)
+            & (np.floor((lo[:, 1] - gy0) / cell) <= j)
+            & (np.floor((hi[:, 1] - gy0) / cell) >= j)
+        )
+        expected.append(np.flatnonzero(inside & touches))
+    np.testing.assert_array_equal(start, np.cumsum([0] + [len(e) for e in expected]))
+    np.testing.assert_array_equal(ids, np.concatenate(expected))
+    np.testing.assert_array_equal(data, circles[ids])
