@@ -164,7 +164,8 @@ def apply_sensor_model(
     (REP 117); dropped beams read ``nan``.
 
     Args:
-        ranges: exact ranges (m); ``inf`` where nothing was hit.
+        ranges: exact ranges (m), float64 (other dtypes are converted); ``inf`` where
+            nothing was hit.
         geometry: the lidar's limits.
         noise_std_m: standard deviation of the range noise (m).
         dropout_prob: probability that a beam returns nothing.
@@ -173,6 +174,9 @@ def apply_sensor_model(
 
     Returns:
         float32 ranges as published in a LaserScan.
+
+    Raises:
+        ValueError: if the draws do not have the shape of ``ranges``.
     """
     # What this computes, element by element and compiled (numpy's calls on one robot's
     # or a small fleet's scans cost more than the arithmetic), with numpy's promotion

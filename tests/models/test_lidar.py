@@ -126,3 +126,10 @@ def test_the_sensor_model_matches_its_numpy_formulation_bit_for_bit(dtype):
         want = _numpy_sensor_model(exact, geometry, noise, dropout, normals, uniforms)
         assert got.dtype == np.float32 and got.shape == want.shape
         np.testing.assert_array_equal(got.view(np.int32), want.view(np.int32))
+
+
+def test_the_sensor_model_refuses_draws_of_another_shape():
+    geometry = ScanGeometry(4, 2 * math.pi, 0.1, 10.0)
+    normals, uniforms = _draws((2, 4), 5)
+    with pytest.raises(ValueError, match=r"draws of shapes \(2, 4\) and \(4,\)"):
+        apply_sensor_model(np.full((2, 4), 3.0), geometry, 0.01, 0.0, normals, uniforms[0])
