@@ -47,6 +47,32 @@ _GRID_SHIFT = 0.0137
 where they would be registered (and tested) in two cells instead of one."""
 _MAX_CELLS = 4_000_000
 """Cap on the grid size; larger scenes get coarser cells (memory, not correctness)."""
+_CELL_PER_SPACING = 0.7
+_CELL_RANGE_M = (1.0, 2.0)
+
+
+def scene_cell_m(segments: FloatArray) -> float:
+    """A grid cell for :class:`StaticScene` suited to how densely the segments fill the hall.
+
+    A beam costs the cells it walks plus the segments it tests in them; the mean spacing of
+    the segments, ``sqrt(area / count)``, balances the two. The cell is 0.7 times that
+    spacing, kept within 1-2 m. Measured (360 beams, 10 m): in ``warehouse-random``'s
+    30 m x 30 m hall (112 segments) the rule's 2 m casts 17 % faster than 1 m; for
+    ``fleet50`` (304 segments) it gives 1.22 m, 5 % faster than 1 m; for the full halls of
+    ``make bench`` (412 and 5,920 segments) 1.05 and 1.0 m, where 1 m was fastest. Only
+    speed depends on the cell: every beam's range is the same for any cell.
+
+    Args:
+        segments: (s, 4) segments ``x0, y0, x1, y1`` (m).
+    """
+    seg = np.asarray(segments, dtype=np.float64).reshape(-1, 4)
+    lo, hi = _CELL_RANGE_M
+    if not len(seg):
+        return lo
+    xs, ys = seg[:, 0::2], seg[:, 1::2]
+    area = float(xs.max() - xs.min()) * float(ys.max() - ys.min())
+    spacing = math.sqrt(area / len(seg))
+    return min(max(_CELL_PER_SPACING * spacing, lo), hi)
 
 
 def _bin_py(

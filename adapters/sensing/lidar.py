@@ -25,11 +25,8 @@ from cosim.timebase import period_ns
 from models.kinematics import FleetState
 from models.lidar import ScanGeometry, apply_sensor_model
 from models.obstacles import DynamicObstacles
-from models.raycast import StaticScene, cast_batch
+from models.raycast import StaticScene, cast_batch, scene_cell_m
 from models.world import Warehouse
-
-SCENE_CELL_M = 1.0
-"""Grid cell of the static scene (m): fastest in `make bench` for warehouse halls."""
 
 
 class LidarAdapter:
@@ -50,7 +47,8 @@ class LidarAdapter:
         self.dropout_prob = cfg.dropout_prob
         self.period_ns = period_ns(cfg.rate_hz)
         self.fleet = run.service(FleetState)
-        self.scene = StaticScene(run.service(Warehouse).segments(), cell_m=SCENE_CELL_M)
+        segments = run.service(Warehouse).segments()
+        self.scene = StaticScene(segments, cell_m=scene_cell_m(segments))
         self.dynamic = run.service(DynamicObstacles)
         self.beam_angles = self.geometry.angles()
         names = self.fleet.names
