@@ -11,10 +11,9 @@ from typing import Any
 
 import numpy as np
 
-from adapters.sensing.lidar import SCENE_CELL_M
 from models.errors import ModelError
 from models.lidar import cast_reference
-from models.raycast import StaticScene, cast_batch
+from models.raycast import StaticScene, cast_batch, scene_cell_m
 from models.world import Warehouse, WarehouseSpec, generate_warehouse
 
 Result = dict[str, Any]
@@ -22,7 +21,6 @@ Result = dict[str, Any]
 BEAMS = 360
 RANGE_MAX_M = 10.0
 ROBOT_RADIUS_M = 0.33
-CELL_M = SCENE_CELL_M  # what the lidar adapter uses
 
 
 def _full_hall(size_m: float, robots: int, upper: int) -> tuple[Warehouse, int]:
@@ -66,7 +64,8 @@ def _scene_case(size_m: float, robots: int, upper: int, repeat: int) -> tuple[Re
     world, shelves = _full_hall(size_m, robots, upper)
     segments = world.segments()
     start = time.perf_counter()
-    scene = StaticScene(segments, cell_m=CELL_M)
+    cell_m = scene_cell_m(segments)  # as the lidar adapter chooses it
+    scene = StaticScene(segments, cell_m=cell_m)
     build_s = time.perf_counter() - start
     origins = np.ascontiguousarray(world.starts[:, :2])
     yaws = np.ascontiguousarray(world.starts[:, 2])
@@ -89,7 +88,7 @@ def _scene_case(size_m: float, robots: int, upper: int, repeat: int) -> tuple[Re
         "robots": robots,
         "beams": BEAMS,
         "range_max_m": RANGE_MAX_M,
-        "cell_m": CELL_M,
+        "cell_m": round(cell_m, 3),
         "hit_fraction": round(float(np.isfinite(ranges).mean()), 4),
         "scene_build_s": round(build_s, 5),
         "first_call_s": round(first_s, 4),

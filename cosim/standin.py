@@ -197,6 +197,8 @@ def run_standin(
     name = options.name
     state = FleetState([name], np.array([[options.x_m, options.y_m, options.yaw_rad]]), RADIUS_M)
     limits, rng = options.limits, np.random.default_rng(options.seed)
+    # the step is compiled: load it now (a proposal changes nothing), not in the first tick
+    state.propose(limits, 0.0)
     sigma = np.array([options.noise_std_m, options.noise_std_m, options.noise_std_rad])
     period_ns = round(1e9 / options.rate_hz)
     latency_ns, timeout_ns = round(options.latency_ms * 1e6), round(options.cmd_timeout_s * 1e9)

@@ -176,6 +176,16 @@ class CollisionChecker:
         self._robots = _manager(self._robot_objects)
         self._placed = np.zeros((len(self.radii), 2))
 
+    @property
+    def floor_min_m(self) -> float:
+        """What :meth:`floor` never returns less than (m): the growth of the robots.
+
+        FCL measures the grown shapes, whose distances are never negative, and the floor
+        adds the growth back; so a caller holding a clearance at or below this value
+        knows that the floor cannot lower it.
+        """
+        return self.grow_m
+
     def _place_robots(self, x: FloatArray, y: FloatArray) -> None:
         moved = np.flatnonzero((x != self._placed[:, 0]) | (y != self._placed[:, 1]))
         if not len(moved):
@@ -196,6 +206,8 @@ class CollisionChecker:
             self._robots.collide(pairs, _collect)
         else:
             self._robots.collide(other, pairs, _collect)
+        if not pairs:  # the common case: skip building and sorting an empty array
+            return np.zeros((0, 2), dtype=np.int64)
         found = np.array([(_index(a), _index(b)) for a, b in pairs], dtype=np.int64)
         found = found.reshape(-1, 2)
         return np.sort(found, axis=1) if other is None else found
@@ -235,26 +247,25 @@ class CollisionChecker:
         (every pair that can then come closer than the margin is a candidate).
         """
         radii = self.radii
-        r, b = candidates.static[:, 0], candidates.static[:, 1]
-        i, j = candidates.robot[:, 0], candidates.robot[:, 1]
-        q, d = candidates.dynamic[:, 0], candidates.dynamic[:, 1]
-        dx, dy, dr = candidates.discs[d].T
+        # most steps have no candidates of some kind (often of any): their empty clearances
+        # are made directly, as indexing empty arrays costs more than the rest of the step
+        static = np.zeros(0)
+        if len(candidates.static):
+            r, b = candidates.static[:, 0], candidates.static[:, 1]
+            static = disc_box_clearance(x[r], y[r], radii[r], self.boxes[b])
+        robot = np.zeros(0)
+        if len(candidates.robot):
+            i, j = candidates.robot[:, 0], candidates.robot[:, 1]
+            robot = np.hypot(x[i] - x[j], y[i] - y[j]) - radii[i] - radii[j]
+        dynamic = np.zeros(0)
+        if len(candidates.dynamic):
+            q, d = candidates.dynamic[:, 0], candidates.dynamic[:, 1]
+            dx, dy, dr = candidates.discs[d].T
+            dynamic = np.hypot(x[q] - dx, y[q] - dy) - radii[q] - dr
         return [
-            Gaps(
-                OtherKind.STATIC,
-                candidates.static,
-                disc_box_clearance(x[r], y[r], radii[r], self.boxes[b]),
-            ),
-            Gaps(
-                OtherKind.ROBOT,
-                candidates.robot,
-                np.hypot(x[i] - x[j], y[i] - y[j]) - radii[i] - radii[j],
-            ),
-            Gaps(
-                OtherKind.DYNAMIC,
-                candidates.dynamic,
-                np.hypot(x[q] - dx, y[q] - dy) - radii[q] - dr,
-            ),
+            Gaps(OtherKind.STATIC, candidates.static, static),
+            Gaps(OtherKind.ROBOT, candidates.robot, robot),
+            Gaps(OtherKind.DYNAMIC, candidates.dynamic, dynamic),
         ]
 
     def evaluate(

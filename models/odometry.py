@@ -21,7 +21,7 @@ import numpy as np
 import numpy.typing as npt
 
 from models.arrays import FloatArray
-from models.kinematics import integrate
+from models.kinematics import integrate_fleet
 
 
 def drift_increments(
@@ -54,5 +54,16 @@ def advance(
     ds_m: FloatArray,
     dtheta_rad: FloatArray,
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Integrate measured increments into odometry poses (frame ``odom``), as an exact arc."""
-    return integrate(x, y, yaw, ds_m, dtheta_rad, 1.0)
+    """Integrate measured increments into odometry poses (frame ``odom``), as an exact arc.
+
+    :func:`models.kinematics.integrate` over a step of 1 (the increments are the step's).
+    """
+    f64 = np.float64
+    return integrate_fleet(
+        np.asarray(x, f64),
+        np.asarray(y, f64),
+        np.asarray(yaw, f64),
+        np.asarray(ds_m, f64),
+        np.asarray(dtheta_rad, f64),
+        1.0,
+    )

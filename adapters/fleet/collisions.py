@@ -86,23 +86,32 @@ class CollisionsAdapter:
         final, least = checker.summarize(gaps)
         attempted = [p for p in final if p.clearance_m < 0]
         held = np.zeros(len(motion.x), dtype=bool)
-        while True:
-            touching = np.zeros_like(held)
-            for group in gaps:
-                touching[group.robots_in_contact()] = True
-            new = touching & ~held
-            if not new.any():  # what is left overlapped already before the step
-                break
-            held |= new
-            self.fleet.hold(motion, np.flatnonzero(new))
-            shift = np.hypot(motion.x - candidates.x, motion.y - candidates.y).max()
-            if shift > checker.margin_m:
-                candidates = checker.candidates(motion.x, motion.y, self.dynamic.discs)
-            gaps = checker.gaps(candidates, motion.x, motion.y)
+        # ``least`` is the smallest clearance of every candidate pair: unless it is negative
+        # nothing overlaps and nobody would be held (most steps skip the loop's array work)
+        if least < 0:
+            while True:
+                touching = np.zeros_like(held)
+                for group in gaps:
+                    touching[group.robots_in_contact()] = True
+                new = touching & ~held
+                if not new.any():  # what is left overlapped already before the step
+                    break
+                held |= new
+                self.fleet.hold(motion, np.flatnonzero(new))
+                shift = np.hypot(motion.x - candidates.x, motion.y - candidates.y).max()
+                if shift > checker.margin_m:
+                    candidates = checker.candidates(motion.x, motion.y, self.dynamic.discs)
+                gaps = checker.gaps(candidates, motion.x, motion.y)
         if held.any():
             final, least = checker.summarize(gaps)
-        # pairs farther apart than the margin only matter until a closer one was seen
-        if self.min_clearance_m >= NEAR_MISS_M and least >= NEAR_MISS_M:
+        # pairs farther apart than the margin only matter until a closer one was seen; and
+        # the floor is never below ``checker.floor_min_m``, so once the smallest clearance is
+        # at or below that, the floor cannot lower it (its FCL distance queries are skipped)
+        if (
+            self.min_clearance_m >= NEAR_MISS_M
+            and least >= NEAR_MISS_M
+            and self.min_clearance_m > checker.floor_min_m
+        ):
             least = min(least, checker.floor(candidates))
         self.min_clearance_m = min(self.min_clearance_m, least)
         near = {(p.robot, p.kind.value, p.other) for p in final}

@@ -66,6 +66,12 @@ class FleetAdapter:
         self._noise = BlockDraws([run.rng.stream(f"odometry/{n}") for n in names], width=2)
         self._frames = [(f"{n}/odom", f"{n}/base_link") for n in names]
         self.mirrors = Mirrors(self.state)
+        # the step and the odometry arc are compiled: load them now rather than in the first
+        # tick, where a real-time run would fall behind the wall clock (proposals change
+        # nothing, and neither does an arc whose result is dropped)
+        self.state.propose(self.limits, self.dt_s)
+        zeros = np.zeros(len(names))
+        advance(self.odom[:, 0], self.odom[:, 1], self.odom[:, 2], zeros, zeros)
         run.provide(self.state)
         run.provide(self.mirrors)
         run.provide(self)

@@ -25,11 +25,8 @@ from cosim.timebase import period_ns
 from models.kinematics import FleetState
 from models.lidar import ScanGeometry, apply_sensor_model
 from models.obstacles import DynamicObstacles
-from models.raycast import StaticScene, cast_batch
+from models.raycast import StaticScene, cast_batch, scene_cell_m
 from models.world import Warehouse
-
-SCENE_CELL_M = 1.0
-"""Grid cell of the static scene (m): fastest in `make bench` for warehouse halls."""
 
 
 class LidarAdapter:
@@ -50,7 +47,8 @@ class LidarAdapter:
         self.dropout_prob = cfg.dropout_prob
         self.period_ns = period_ns(cfg.rate_hz)
         self.fleet = run.service(FleetState)
-        self.scene = StaticScene(run.service(Warehouse).segments(), cell_m=SCENE_CELL_M)
+        segments = run.service(Warehouse).segments()
+        self.scene = StaticScene(segments, cell_m=scene_cell_m(segments))
         self.dynamic = run.service(DynamicObstacles)
         self.beam_angles = self.geometry.angles()
         names = self.fleet.names
@@ -68,6 +66,8 @@ class LidarAdapter:
         self._zeros = np.zeros((len(names), beams), dtype=np.float32)
         self._ones = np.ones((len(names), beams), dtype=np.float32)
         self.topics = [topic(name, "scan") for name in self.fleet.names]
+        self._own = np.arange(len(names), dtype=np.int64)  # each robot's own circle
+        self._frames = [f"{name}/laser" for name in names]
         self.scans = 0
         if cfg.beams > 0:
             for name in self.topics:
@@ -81,16 +81,15 @@ class LidarAdapter:
     def _scan(self, run: RunContext, now_ns: int) -> None:
         fleet = self.fleet
         geometry = self.geometry
-        circles = np.stack([fleet.x, fleet.y, fleet.radius_m], axis=1)
-        if len(self.dynamic):
-            circles = np.vstack([circles, self.dynamic.discs])
+        bodies = np.stack([fleet.x, fleet.y, fleet.radius_m], axis=1)
+        circles = np.vstack([bodies, self.dynamic.discs]) if len(self.dynamic) else bodies
         exact = cast_batch(
             self.scene,
-            fleet.positions,
+            bodies[:, :2],
             fleet.yaw,
             self.beam_angles,
             circles,
-            np.arange(len(fleet), dtype=np.int64),
+            self._own,
             geometry.range_max_m,
         )
         scan_time_s = self.period_ns / 1e9
@@ -100,15 +99,16 @@ class LidarAdapter:
         scans = apply_sensor_model(
             exact, geometry, self.noise_std_m, self.dropout_prob, normals, uniforms
         )
+        angle_min, increment = geometry.angle_min_rad, geometry.angle_increment_rad
         for i, name in enumerate(fleet.names):
             ranges = scans[i]
             run.bus.publish(
                 self.topics[i],
                 LaserScan(
                     now_ns,
-                    f"{name}/laser",
-                    geometry.angle_min_rad,
-                    geometry.angle_increment_rad,
+                    self._frames[i],
+                    angle_min,
+                    increment,
                     geometry.range_min_m,
                     geometry.range_max_m,
                     scan_time_s,

@@ -17,10 +17,7 @@ from cosim.plotting.people import PeopleSamples
 from cosim.plotting.rundata import RunData
 from models.arrays import BoolArray, FloatArray
 from models.lidar import ScanGeometry
-from models.raycast import StaticScene, cast_batch
-
-SCENE_CELL_M = 1.0
-"""Grid cell of the static scene (m), as the lidar adapter's (only speed depends on it)."""
+from models.raycast import StaticScene, cast_batch, scene_cell_m
 
 
 class LidarRays:
@@ -45,7 +42,8 @@ class LidarRays:
         self.angles: FloatArray = geometry.angles()[::step] if cfg.beams else np.zeros(0)
         self.range_max_m = cfg.range_max_m
         self.radius_m = run.scenario.robots.radius_m
-        self.scene = StaticScene(run.warehouse.segments(), cell_m=SCENE_CELL_M)
+        segments = run.warehouse.segments()
+        self.scene = StaticScene(segments, cell_m=scene_cell_m(segments))
         self.track = run.track
         self.robot = robot
         self.people = PeopleSamples(run)

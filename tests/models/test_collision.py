@@ -81,3 +81,29 @@ def test_random_configurations_agree_with_shapely():
             assert clearance == pytest.approx(min(gaps), abs=1e-3)
         else:
             assert clearance < 1e-9
+
+
+def test_the_floor_is_never_below_floor_min_m():
+    rng = np.random.default_rng(5)
+    boxes = np.array([[1.0, 1.0, 3.0, 1.8], [4.0, 4.0, 4.8, 6.0], [0.0, 6.0, 2.0, 6.4]])
+    checker = CollisionChecker(boxes, np.full(5, 0.3), margin_m=0.1)
+    floors = []
+    for _ in range(200):
+        x = rng.uniform(0, 7, 5)
+        y = rng.uniform(0, 7, 5)
+        discs = rng.uniform([0, 0, 0.1], [7, 7, 0.4], (2, 3))
+        floor = checker.floor(checker.candidates(x, y, discs))
+        assert floor >= checker.floor_min_m
+        floors.append(floor)
+    assert min(f for f in floors if math.isfinite(f)) < checker.floor_min_m + 0.5
+
+
+def test_empty_candidate_groups_give_empty_clearances():
+    checker = CollisionChecker(BOXES, np.array([0.3, 0.3]), margin_m=0.1)
+    x, y = np.array([0.5, 9.0]), np.array([0.5, 9.0])
+    gaps = checker.gaps(checker.candidates(x, y), x, y)
+    assert [group.kind for group in gaps] == list(OtherKind)
+    for group in gaps:
+        assert group.pairs.shape == (0, 2)
+        assert group.clearance_m.shape == (0,)
+        assert group.clearance_m.dtype == np.float64

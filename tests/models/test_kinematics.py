@@ -5,7 +5,14 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from models.kinematics import DriveLimits, FleetState, integrate, limit_commands, wrap_angle
+from models.kinematics import (
+    DriveLimits,
+    FleetState,
+    integrate,
+    integrate_fleet,
+    limit_commands,
+    wrap_angle,
+)
 
 LIMITS = DriveLimits(1.0, 0.3, 2.0, 2.0, 3.0)
 
@@ -97,3 +104,73 @@ def test_wrap_angle_maps_into_minus_pi_to_pi():
     angles = wrap_angle(np.array([math.pi, -math.pi, 3 * math.pi, 0.1, -7.0]))
     assert np.all(angles >= -math.pi) and np.all(angles < math.pi)
     assert angles[3] == pytest.approx(0.1)
+
+
+def _bits(*arrays):
+    return [np.asarray(a, dtype=np.float64).view(np.int64) for a in arrays]
+
+
+def _numpy_propose(state, limits, dt):
+    """The step as limit_commands, the stopped mask and integrate define it."""
+    v, w = limit_commands(state.v, state.w, state.v_cmd, state.w_cmd, limits, dt)
+    v = np.where(state.stopped, 0.0, v)
+    w = np.where(state.stopped, 0.0, w)
+    return (*integrate(state.x, state.y, state.yaw, v, w, dt), v, w)
+
+
+def _random_fleet(rng, n):
+    starts = np.column_stack(
+        [rng.uniform(-50, 50, n), rng.uniform(-50, 50, n), rng.uniform(-4, 4, n)]
+    )
+    state = FleetState([f"r{i}" for i in range(n)], starts, 0.3)
+    state.v = rng.uniform(-0.5, 1.2, n)
+    state.w = rng.uniform(-2.5, 2.5, n)
+    # commands beyond the limits, on them, signed zeros, exact ties with the slew bounds
+    special = np.array([0.0, -0.0, 1.0, -0.3, 2.0, -2.0, 7.0, -7.0])
+    state.v_cmd = np.where(rng.random(n) < 0.4, rng.choice(special, n), rng.uniform(-2, 2, n))
+    state.w_cmd = np.where(rng.random(n) < 0.4, rng.choice(special, n), rng.uniform(-4, 4, n))
+    tie = rng.random(n) < 0.1
+    state.v_cmd[tie] = state.v[tie] + LIMITS.max_accel_mps2 * 0.05
+    state.stopped = rng.random(n) < 0.2
+    return state
+
+
+def test_the_compiled_fleet_step_matches_the_numpy_definition_bit_for_bit():
+    rng = np.random.default_rng(8)
+    for trial in range(3000):
+        state = _random_fleet(rng, int(rng.integers(1, 12)))
+        if trial % 10 == 0:
+            state.w[:] = 0.0
+            state.w_cmd[:] = -0.0
+        dt = float(rng.choice([0.05, 0.1, 1 / 30, 0.5]))
+        motion = state.propose(LIMITS, dt)
+        got = _bits(motion.x, motion.y, motion.yaw, motion.v, motion.w)
+        want = _bits(*_numpy_propose(state, LIMITS, dt))
+        for name, g, e in zip(["x", "y", "yaw", "v", "w"], got, want, strict=True):
+            np.testing.assert_array_equal(g, e, err_msg=f"{name}, trial {trial}")
+
+
+def test_a_nan_command_propagates_as_numpy_clip_keeps_it():
+    state = FleetState(["r0", "r1"], np.zeros((2, 3)), 0.3)
+    state.v_cmd = np.array([np.nan, 0.5])
+    state.w_cmd = np.array([0.1, np.nan])
+    motion = state.propose(LIMITS, 0.05)
+    want = _numpy_propose(state, LIMITS, 0.05)
+    moved = (motion.x, motion.y, motion.yaw, motion.v, motion.w)
+    for got, expected in zip(moved, want, strict=True):
+        np.testing.assert_array_equal(got, expected)
+
+
+def test_integrate_fleet_matches_integrate_bit_for_bit_at_wrap_edges_and_zero_rates():
+    rng = np.random.default_rng(9)
+    n = 20_000
+    x, y = rng.uniform(-100, 100, n), rng.uniform(-100, 100, n)
+    yaw = np.concatenate([rng.uniform(-4, 4, n - 8), [math.pi, -math.pi, 0.0, -0.0] * 2])
+    v = rng.uniform(-2, 2, n)
+    w = np.where(rng.random(n) < 0.2, 0.0, rng.uniform(-6, 6, n))
+    w[-8:] = [0.0, 0.0, math.pi, -math.pi, 2 * math.pi, -2 * math.pi, -0.0, 1e-300]
+    for dt in (0.05, 1.0, 0.5):
+        got = _bits(*integrate_fleet(x, y, yaw, v, w, dt))
+        want = _bits(*integrate(x, y, yaw, v, w, dt))
+        for g, e in zip(got, want, strict=True):
+            np.testing.assert_array_equal(g, e)

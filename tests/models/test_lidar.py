@@ -99,3 +99,37 @@ def test_beam_directions_are_unit_vectors_at_the_beam_angles():
     np.testing.assert_allclose(
         np.arctan2(dy, dx), np.angle(np.exp(1j * (yaws[:, None] + beams))), atol=1e-12
     )
+
+
+def _numpy_sensor_model(ranges, geometry, noise_std_m, dropout_prob, normals, uniforms):
+    """The sensor model in numpy terms (numpy's promotion rules decide the precisions)."""
+    out = np.where(np.isfinite(ranges), ranges + normals * noise_std_m, np.inf)
+    out = np.where(out > geometry.range_max_m, np.inf, out)
+    out = np.where(out < geometry.range_min_m, -np.inf, out)
+    out = np.where(uniforms < dropout_prob, np.nan, out)
+    return out.astype(np.float32)
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_the_sensor_model_matches_its_numpy_formulation_bit_for_bit(dtype):
+    rng = np.random.default_rng(12)
+    geometry = ScanGeometry(360, 2 * math.pi, 0.1, 10.0)
+    for noise, dropout in [(0.01, 0.0), (0.0, 0.0), (0.05, 0.1), (0.3, 0.7), (0.02, 1.0)]:
+        exact = rng.uniform(0.0, 10.2, (6, 360))
+        exact[rng.random(exact.shape) < 0.2] = math.inf
+        exact[0, :4] = [math.nan, -math.inf, 0.1, 10.0]
+        normals = rng.standard_normal((6, 360)).astype(dtype)
+        uniforms = rng.random((6, 360)).astype(dtype)
+        uniforms[0, :2] = dtype(dropout)  # ties with the dropout probability
+        block = np.stack([normals, normals], axis=1)  # a strided view, as BlockDraws gives
+        got = apply_sensor_model(exact, geometry, noise, dropout, block[:, 0], uniforms)
+        want = _numpy_sensor_model(exact, geometry, noise, dropout, normals, uniforms)
+        assert got.dtype == np.float32 and got.shape == want.shape
+        np.testing.assert_array_equal(got.view(np.int32), want.view(np.int32))
+
+
+def test_the_sensor_model_refuses_draws_of_another_shape():
+    geometry = ScanGeometry(4, 2 * math.pi, 0.1, 10.0)
+    normals, uniforms = _draws((2, 4), 5)
+    with pytest.raises(ValueError, match=r"draws of shapes \(2, 4\) and \(4,\)"):
+        apply_sensor_model(np.full((2, 4), 3.0), geometry, 0.01, 0.0, normals, uniforms[0])

@@ -278,3 +278,68 @@ def test_a_scene_spanning_a_huge_area_still_finds_its_segments():
         5.0,
     )
     assert ranges[0, 0] == pytest.approx(3.0, abs=1e-12)
+
+
+def test_circles_are_binned_in_every_cell_their_padded_box_touches_and_spill_outside_the_grid():
+    rng = np.random.default_rng(11)
+    scene = StaticScene(box_segments(np.array([[0.0, 0.0, 10.0, 10.0]])), cell_m=1.0)
+    gx0, gy0, cell, nx, ny = scene.grid
+    circles = np.column_stack([rng.uniform(-3, 13, (40, 2)), rng.uniform(0.05, 1.5, 40)])
+    circles[0] = [gx0 + 3 * cell, gy0 + 2 * cell, cell]  # a box edge on grid lines
+    circles[1, 0] = np.nan
+    start, data, ids, spilled = scene.bin_circles(circles)
+    pad = 1e-7  # models.raycast._PAD_M
+    lo = circles[:, :2] - (circles[:, 2:] + pad)
+    hi = circles[:, :2] + (circles[:, 2:] + pad)
+    inside = np.all((lo > [gx0, gy0]) & (hi < [gx0 + nx * cell, gy0 + ny * cell]), axis=1)
+    np.testing.assert_array_equal(spilled, np.flatnonzero(~inside))
+    assert 1 in spilled
+    expected = []
+    for c in range(int(nx * ny)):
+        i, j = c % int(nx), c // int(nx)
+        touches = (
+            (np.floor((lo[:, 0] - gx0) / cell) <= i)
+            & (np.floor((hi[:, 0] - gx0) / cell) >= i)
+            & (np.floor((lo[:, 1] - gy0) / cell) <= j)
+            & (np.floor((hi[:, 1] - gy0) / cell) >= j)
+        )
+        expected.append(np.flatnonzero(inside & touches))
+    np.testing.assert_array_equal(start, np.cumsum([0] + [len(e) for e in expected]))
+    np.testing.assert_array_equal(ids, np.concatenate(expected))
+    np.testing.assert_array_equal(data, circles[ids])
+
+
+def test_the_scene_cell_follows_the_spacing_of_the_segments_within_one_to_two_metres():
+    from models.raycast import scene_cell_m
+
+    hall = box_segments(np.array([[0.0, 0.0, 30.0, 30.0]]))
+    sparse = np.vstack([hall, box_segments(np.array([[10.0, 10.0, 12.0, 10.8]] * 20))])
+    assert scene_cell_m(sparse) == 2.0  # 84 segments in 30 m x 30 m
+    dense = np.vstack([hall] * 300)
+    assert scene_cell_m(dense) == 1.0  # 1,200 segments
+    assert scene_cell_m(np.zeros((0, 4))) == 1.0
+    middle = np.vstack([hall] * 76)  # 304 segments, as fleet50's hall
+    assert scene_cell_m(middle) == pytest.approx(0.7 * math.sqrt(900.0 / 304))
+
+
+def test_ranges_do_not_depend_on_the_scene_cell():
+    rng = np.random.default_rng(13)
+    world = _random_world(rng)
+    origins = world.starts[:, :2]
+    circles = np.column_stack([origins, np.full(len(origins), 0.3)])
+    exclude = np.arange(len(origins), dtype=np.int64)
+    beams = np.linspace(-math.pi, math.pi, 360, endpoint=False)
+    ranges = [
+        cast_batch(
+            StaticScene(world.segments(), cell_m=cell),
+            origins,
+            world.starts[:, 2],
+            beams,
+            circles,
+            exclude,
+            10.0,
+        )
+        for cell in (0.5, 1.0, 1.37, 2.0, 3.0)
+    ]
+    for other in ranges[1:]:
+        np.testing.assert_array_equal(other, ranges[0])
