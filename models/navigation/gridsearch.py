@@ -36,6 +36,8 @@ DY = np.array([0, 0, 1, -1, 1, -1, 1, -1], dtype=np.int64)
 """y offsets of the 8 moves."""
 _F_STEPS = 2.0**28
 """A*'s ``f`` is rounded to multiples of ``1 / _F_STEPS`` cells (see the A*)."""
+UNREACHED = int(np.iinfo(np.int32).max)
+"""Stored landmark distance of a cell that no path from the landmark reaches."""
 
 
 def readonly(array: npt.NDArray[Any]) -> npt.NDArray[Any]:
@@ -87,7 +89,10 @@ def _astar_py(
     dys: IntArray,
     lanes: UInt8Array,
     against: float,
-) -> tuple[bool, IntArray, int, int, float, int]:
+    fields: npt.NDArray[np.int32],
+    field_scale: float,
+    floor: UInt8Array,
+) -> tuple[bool, IntArray, int, int, float, int, int]:
     """A* with an indexed binary heap (decrease-key) ordered by ``(f, -g)``.
 
     Per cell: ``g``; ``pos``, its heap index + 1 while open (0 unseen, -1 closed);
@@ -113,14 +118,28 @@ def _astar_py(
     empty (0, 0) array: a step whose move runs against the lane of the cell it enters
     costs ``against`` times more.
 
+    ``fields`` (rows * cols, K) landmark distances and ``field_scale`` their scale
+    (:class:`models.navigation.landmarks.Landmarks`), or an empty (0, 0) array: the
+    heuristic is then the larger of the octile distance and the landmark bound, and a
+    cell the landmarks show to be cut off from the goal is never opened. ``floor``
+    (rows, cols) are the static costs the fields were computed on: the search stops at
+    the first enterable cell it reads whose cost is below them (the bound would not
+    hold there).
+
     Returns found, the path cells (n, 2), its straight and diagonal step counts, its
-    cost in cells, and the number of expansions.
+    cost in cells, the number of expansions, and the flat index of a cell below
+    ``floor`` (-1 if none was read).
     """
     height, width = cost.shape
     n = width * height
     grid = cost.ravel()
     lane = lanes.ravel()
     use_lanes = lane.shape[0] == n
+    marks = fields.shape[1] if fields.shape[0] == n else 0
+    goal_marks = np.empty(marks, dtype=np.int32)
+    for f in range(marks):
+        goal_marks[f] = fields[gy * width + gx, f]
+    least = floor.ravel()
     offsets = dys * width + dxs
     buf = np.zeros(n + (5 * n + 7) // 8)
     g = buf[:n]
@@ -196,6 +215,8 @@ def _astar_py(
             if slot < 0:
                 continue
             c_nb = int(grid[nb])
+            if marks > 0 and c_nb < least[nb] and c_nb < lethal:
+                return False, np.zeros((0, 2), dtype=np.int64), 0, 0, np.inf, expansions, nb
             if c_nb >= lethal:
                 if not _escapes(nx, ny, sx, sy, escape_r2):
                     continue
@@ -221,10 +242,16 @@ def _astar_py(
             ng = node_g + step
             if slot > 0 and ng >= g[nb]:
                 continue
-            g[nb] = ng
-            parent[nb] = k
             hx, hy = abs(nx - gx), abs(ny - gy)
             h = (hx + hy) + (SQRT2 - 2.0) * min(hx, hy)
+            if marks > 0:
+                bound = _landmark_bound(fields, nb, goal_marks)
+                if bound < 0:
+                    pos[nb] = -1  # cut off from the goal: never open it
+                    continue
+                h = max(h, bound * field_scale)
+            g[nb] = ng
+            parent[nb] = k
             nf = math.floor((ng + h) * _F_STEPS + 0.5) / _F_STEPS
             if slot == 0:
                 i = size
@@ -246,7 +273,7 @@ def _astar_py(
             heap_k[2 * i], heap_k[2 * i + 1], heap_n[i] = nf, ng, nb
             pos[nb] = i + 1
     if not found:
-        return False, np.zeros((0, 2), dtype=np.int64), 0, 0, np.inf, expansions
+        return False, np.zeros((0, 2), dtype=np.int64), 0, 0, np.inf, expansions, -1
     count = 1
     node = goal
     while node != start:
@@ -261,7 +288,26 @@ def _astar_py(
         if i > 0:
             diagonal += parent[node] >= 4
             node -= offsets[parent[node]]
-    return True, path, count - 1 - diagonal, diagonal, g[goal], expansions
+    return True, path, count - 1 - diagonal, diagonal, g[goal], expansions, -1
+
+
+def _landmark_bound_py(
+    fields: npt.NDArray[np.int32], cell: int, goal_marks: npt.NDArray[np.int32]
+) -> int:
+    """The largest ``|D_k[goal] - D_k[cell]|`` (stored units); -1 if ``cell`` is cut off.
+
+    Every landmark lies in the same connected region, so a cell is reached by all of
+    them or by none: one field tells which, and the loop over the rest has no branch.
+    """
+    first = fields[cell, 0]
+    if (first == UNREACHED) != (goal_marks[0] == UNREACHED):
+        return -1
+    if first == UNREACHED:
+        return 0
+    best = np.int32(0)
+    for f in range(goal_marks.shape[0]):
+        best = max(best, abs(goal_marks[f] - fields[cell, f]))
+    return int(best)
 
 
 def _escapes_py(x: int, y: int, sx: int, sy: int, r2: int) -> bool:
@@ -342,6 +388,7 @@ def _prune_py(cost: UInt8Array, cells: IntArray, lethal: int, keep_clearance: bo
 
 # numba resolves the helpers when a kernel is first compiled, so their order is free
 _escapes: Any = numba.njit(cache=True)(_escapes_py)
+_landmark_bound: Any = numba.njit(cache=True, inline="always")(_landmark_bound_py)
 _line_ok: Any = numba.njit(cache=True)(_line_ok_py)
 escape_r2: Any = numba.njit(cache=True)(_escape_r2_py)
 astar: Any = numba.njit(cache=True)(_astar_py)
