@@ -6,9 +6,11 @@ triangle inequality gives ``d(n, g) >= |d(L, g) - d(L, n)|`` on a graph whose st
 cost the same both ways; the largest such bound over a few landmarks, or the octile
 distance if larger, is a consistent heuristic, exact for cells on a least-cost path
 from a landmark to the goal. On the 100 m x 100 m hall (1004 x 1004 cells, 8 landmarks,
-200 fleet-like plans) it cuts A*'s expansions 2.1x at cost weight 1 and 2.1x at 0, and
-its mean time 1.5x; what is left lies mostly in the vast sets of equal-cost paths of the
-8-connected grid, where no bound short of the exact cost-to-go helps.
+200 fleet-like searches, ``bench/landmarks_bench.py``) it cuts A*'s mean expansions 2.3x
+at cost weight 1 and 2.1x at 0, and its mean time 1.6x and 1.5x; what is left lies
+mostly in the vast sets of equal-cost paths of the 8-connected grid, where no bound
+short of the exact cost-to-go helps (12 or 16 landmarks expand 8 and 12 % fewer cells
+but cost more per cell, and are no faster).
 
 Cost model: that of :mod:`models.navigation.planner`, made symmetric by charging a step
 for the cheaper of its two cells: ``step * (1 + cost_weight * min(c_from, c_to) / 252)``.
@@ -65,18 +67,18 @@ Int32Array = npt.NDArray[np.int32]
 DEFAULT_COUNT = 8
 """Landmarks per layer (measured on the 100 m x 100 m hall: 8 plans as fast as 12 or 16)."""
 MAX_COUNT = 16
-ALT_MIN_CELLS = 500_000
+ALT_MIN_CELLS = 300_000
 """Smallest static layer (cells) on which a fleet's planning pays for the landmark fields.
 
-Measured on the fleet50 hall grown with the fleet (``bench/scale_bench.py``'s halls,
-0.1 m cells, 200 fleet-like plans each): per new goal the fields save the full plan and
-the path-length yardstick together 0.1-0.5 ms on 304 x 304 cells (50 robots), 1.7 ms on
-424 x 424 (100), 2.9 ms on 604 x 604 (200), 3.5 ms on 754 x 754 (500) and 4.7 ms on
-1004 x 1004 (1,000), while building both weights' fields takes about 0.15, 0.4, 0.75,
-1.4 and 2.8 s: 250 to 600 goals to break even everywhere, more than 1,000 on the
-smallest. Fleets are sized with their floors, so from about 500,000 cells (a 70 m x 70 m
-hall) the first goal of every robot pays for the fields; on fleet50's floor its 100
-goals a minute would take several minutes to.
+``bench/landmarks_bench.py`` on the fleet50 hall grown with the fleet (the scale study's
+halls, 0.1 m cells, 200 fleet-like searches each): per new goal the fields save the full
+plan and the path-length yardstick together 0.6 ms on 304 x 304 cells (50 robots),
+1.1 ms on 424 x 424 (100), 2.1 ms on 604 x 604 (200), 2.2 ms on 754 x 754 (500) and
+2.9 ms on 1004 x 1004 (1,000); building both weights' fields takes 0.12, 0.2, 0.45, 0.76
+and 1.5 s. They pay after 195, 174, 213, 344 and 509 goals: from the 200-robot hall up,
+within about the first goal of every robot. Below, the fleet50 preset's 60 s (about 100
+goals) would lose about 0.06 s of its 4.5 s; with so little at stake either way its
+plans stay those of the plain heuristic.
 """
 
 
