@@ -57,6 +57,7 @@ from models.mapping.se2 import compose
 from models.navigation.costmap import CostmapParams, StaticCostmap, with_obstacles
 from models.navigation.dwa import DwaParams, dwa_batch
 from models.navigation.follow import PathBook, paths_blocked
+from models.navigation.landmarks import ALT_MIN_CELLS, LandmarkCache
 from models.navigation.lanes import TWO_WAY, aisle_lanes
 from models.navigation.planner import (
     GoalStatus,
@@ -137,6 +138,11 @@ class NavigationAdapter:
                 self.layers[0], ground_truth_grid(run.service(Warehouse), cfg.resolution_m)
             )
         run.provide(self.static)
+        # A*'s landmark bounds on the shared static layer, built on first use, on floors
+        # large enough for the fleet's plans to pay for them (see _full for where they hold)
+        self.landmarks = (
+            LandmarkCache(self.static) if self.static.cost.size >= ALT_MIN_CELLS else None
+        )
         self.measured = MeasuredPoses(run, self.names)
         """Robots localizing by motion capture (or their own reported pose)."""
         self.correction = [(0.0, 0.0, 0.0)] * len(self.names)
@@ -310,7 +316,10 @@ class NavigationAdapter:
         if where is GoalStatus.OK:
             # on the true map from the true position: the yardstick of path_length_ratio
             truth = (float(self.fleet.x[i]), float(self.fleet.y[i]))
-            shortest = shortest_path_length_m(self.static, truth, (goal.x_m, goal.y_m))
+            marks = None if self.landmarks is None else self.landmarks.get(0.0)
+            shortest = shortest_path_length_m(
+                self.static, truth, (goal.x_m, goal.y_m), landmarks=marks
+            )
         if not math.isfinite(shortest):
             detail = where.value if where is not GoalStatus.OK else "enclosed"
             self._drop(run, i, "unreachable", detail)
@@ -421,6 +430,9 @@ class NavigationAdapter:
         cost = with_obstacles(layer, points, discs=discs if len(discs) else None)
         s_cell = layer.world_to_cell(self.pose[i, :2])
         g_cell = layer.world_to_cell(self.goal[i])
+        marks = None
+        if self.landmarks is not None and layer is self.static:
+            marks = self.landmarks.get(1.0)  # not on a map the robot builds: other costs
         result = plan(
             cost,
             s_cell,
@@ -428,6 +440,7 @@ class NavigationAdapter:
             resolution_m=layer.resolution_m,
             lanes=self.lanes,
             against=LANE_AGAINST,
+            landmarks=marks,
         )
         if not result.found:
             return None

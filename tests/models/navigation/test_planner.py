@@ -250,6 +250,15 @@ def test_a_star_finds_the_least_cost_of_a_reference_dijkstra_on_random_grids(see
                 assert _path_cost(cost, result.cells, weight) == pytest.approx(want, rel=1e-12)
 
 
+def test_a_star_across_an_open_floor_closes_only_the_cells_of_its_path():
+    # octile is exact here, and thousands of paths tie; the deepest entry must win the tie
+    # (it did not while the last bits of differently summed equal costs ordered the heap)
+    cost = np.zeros((150, 200), dtype=np.uint8)
+    for weight in (0.0, 1.0):
+        result = plan(cost, (3, 4), (190, 120), cost_weight=weight)
+        assert result.expansions == len(result.cells) == 188
+
+
 def test_the_same_input_gives_the_same_path():
     rng = np.random.default_rng(11)
     cost = rng.integers(0, 200, size=(60, 60)).astype(np.uint8)
