@@ -11,6 +11,7 @@ import numpy as np
 from assignment_bench import assignment_solve_stats
 from dwa_bench import dwa_us_per_robot
 from humans_bench import humans_coupling
+from landmarks_bench import landmark_savings
 from lidar_bench import lidar_rays_per_second
 from mapping_bench import aces_mapping, fleet50_mapping, per_scan_costs
 from network_bench import network_deliveries_per_second
@@ -339,6 +340,7 @@ SUITES: dict[str, Callable[[int], Result]] = {
     "fleet50_wander": fleet50_wander,
     "fleet1000_wander": fleet1000_wander,
     "fleet_scaling": fleet_scaling,
+    "landmarks": landmark_savings,
     "bag_cost": bag_cost,
     "bag_memory_1h": bag_memory_1h,
     "cdr_encoding": encoding,
