@@ -28,7 +28,7 @@ import numpy as np
 from adapters.mapping.geometry import map_geometry
 from adapters.mapping.records import MappingRecords
 from adapters.naming import topic
-from adapters.navigation.stack import ROBOT_STATES
+from adapters.navigation.robots_layer import ROBOT_STATES
 from cosim.adapter import RunContext
 from cosim.bus import Envelope, TopicQos
 from cosim.hosts import BASE_HOST, HostId

@@ -16,7 +16,8 @@ import numpy.typing as npt
 
 from cosim.messages import OccupancyGrid as GridMessage
 from models.navigation.costmap import CostmapParams, StaticCostmap
-from models.occupancy import FREE, UNKNOWN, OccupancyGrid, resample
+from models.navigation.lanes import TWO_WAY, aisle_lanes
+from models.occupancy import FREE, OCCUPIED, UNKNOWN, OccupancyGrid, resample
 
 
 class StaticLayers:
@@ -77,3 +78,26 @@ def _traversable(grid: OccupancyGrid) -> OccupancyGrid:
     """Unknown cells as free (Nav2's ``allow_unknown``)."""
     data = np.where(grid.data == UNKNOWN, FREE, grid.data).astype(np.int8)
     return OccupancyGrid(grid.resolution_m, grid.origin_xy_m, data)
+
+
+def lanes_on(layer: StaticCostmap, truth: OccupancyGrid, width_m: float) -> npt.NDArray[np.uint8]:
+    """The building's one-way lanes on a costmap's cells (two-way where the map reaches past it).
+
+    A robot that maps plans on a grid with a margin around the building; the lanes are laid
+    into it at the building's offset. Both grids share the cell size; aisles up to ``width_m``
+    wide are one-way (:func:`models.navigation.lanes.aisle_lanes`).
+
+    Raises:
+        ValueError: when the costmap does not cover the building.
+    """
+    lanes = aisle_lanes(truth.data >= OCCUPIED, truth.resolution_m, width_m)
+    offset = np.subtract(truth.origin_xy_m, layer.origin_xy_m) / layer.resolution_m
+    ox, oy = (int(v) for v in np.rint(offset))
+    rows, cols = lanes.shape
+    if ox < 0 or oy < 0 or oy + rows > layer.height or ox + cols > layer.width:
+        raise ValueError(
+            f"the costmap {layer.cost.shape} does not cover the building {lanes.shape}"
+        )
+    placed = np.full(layer.cost.shape, TWO_WAY, dtype=np.uint8)
+    placed[oy : oy + rows, ox : ox + cols] = lanes
+    return placed

@@ -28,10 +28,11 @@ import numpy as np
 from adapters.fleet.motion import drive_limits
 from adapters.mapping.geometry import map_geometry, unknown_grid
 from adapters.naming import topic
-from adapters.navigation.layers import StaticLayers
+from adapters.navigation.layers import StaticLayers, lanes_on
 from adapters.navigation.localization import MeasuredPoses
 from adapters.navigation.records import NavRecords
 from adapters.navigation.recovery import Recovery, StallWatch
+from adapters.navigation.robots_layer import RobotsLayer
 from adapters.navigation.scan_memory import MovingMemory, ScanMemory
 from cosim.adapter import RunContext
 from cosim.bus import Envelope
@@ -45,7 +46,6 @@ from cosim.messages import (
     NavStatus,
     Odometry,
     Path,
-    RobotState,
     TFMessage,
     Twist,
 )
@@ -58,7 +58,7 @@ from models.navigation.costmap import CostmapParams, StaticCostmap, with_obstacl
 from models.navigation.dwa import DwaParams, dwa_batch
 from models.navigation.follow import PathBook, paths_blocked
 from models.navigation.landmarks import ALT_MIN_CELLS, LandmarkCache
-from models.navigation.lanes import TWO_WAY, aisle_lanes
+from models.navigation.lanes import TWO_WAY
 from models.navigation.planner import (
     GoalStatus,
     goal_status,
@@ -69,10 +69,9 @@ from models.navigation.planner import (
 )
 from models.navigation.repair import RepairParams, repair_path
 from models.navigation.traffic import TrafficParams, keep_right, moving_points, speed_caps
-from models.occupancy import OCCUPIED, OccupancyGrid, ground_truth_grid
+from models.occupancy import OccupancyGrid, ground_truth_grid
 from models.world import Warehouse
 
-ROBOT_STATES = "/fleet/robot_states"
 PROGRESS_M = 0.2
 """Remaining path length must shrink by this much to count as progress (m)."""
 PATH_CLEARANCE_M = 0.3
@@ -134,8 +133,10 @@ class NavigationAdapter:
         self.lanes: np.ndarray | None = None
         if cfg.traffic == "lanes":
             # drawn on the building's map by the fleet manager, as Open-RMF's lanes are
-            self.lanes = _lanes_on(
-                self.layers[0], ground_truth_grid(run.service(Warehouse), cfg.resolution_m)
+            self.lanes = lanes_on(
+                self.layers[0],
+                ground_truth_grid(run.service(Warehouse), cfg.resolution_m),
+                LANE_WIDTH_M,
             )
         run.provide(self.static)
         # A*'s landmark bounds on the shared static layer, built on first use, on floors
@@ -166,7 +167,11 @@ class NavigationAdapter:
         self.best_remaining = np.full(n, np.inf)
         self.progress_ns = np.zeros(n, dtype=np.int64)
         self.stuck = np.zeros(n, dtype=bool)
-        self.others: list[dict[int, tuple[float, float, float, int]]] = [{} for _ in range(n)]
+        self.robots_layer: RobotsLayer | None = None
+        if cfg.robots_layer:
+            self.robots_layer = RobotsLayer(
+                self.names, self.hosts, radius, cfg.robots_layer_timeout_s
+            )
         self.records = NavRecords(run.recorder, self.names)
         self.radius = radius
         self.rngs = [run.rng.stream(f"navigation/{name}") for name in self.names]
@@ -184,8 +189,8 @@ class NavigationAdapter:
             bus.advertise(status, NavStatus)
             bus.advertise(cmd, Twist)
             bus.advertise(path, Path)
-        if cfg.robots_layer:
-            bus.advertise(ROBOT_STATES, RobotState)
+        if self.robots_layer is not None:
+            self.robots_layer.advertise(run)
 
     # -- the bus ----------------------------------------------------------------------
     def start(self, run: RunContext) -> None:
@@ -206,14 +211,8 @@ class NavigationAdapter:
             lambda now: self._progress(run, now),
             stage=Stage.CONTROL,
         )
-        if self.cfg.robots_layer:
-            for i, host in enumerate(self.hosts):
-                bus.subscribe(ROBOT_STATES, host, self._on_robot_state(i))
-            kernel.every(
-                period_ns(self.cfg.robots_layer_hz),
-                lambda now: self._broadcast(run, now),
-                stage=Stage.CONTROL,
-            )
+        if self.robots_layer is not None:
+            self.robots_layer.start(run, self.cfg.robots_layer_hz, self.pose, self.vel[:, 0])
 
     def _on_measured_pose(self, i: int, x_m: float, y_m: float, yaw_rad: float) -> None:
         self.pose[i] = (x_m, y_m, yaw_rad)
@@ -254,32 +253,6 @@ class NavigationAdapter:
             self.memory.add(i, self.pose[i].copy(), message.ranges_m)
 
         return on_scan
-
-    def _on_robot_state(self, i: int) -> Callable[[Message, Envelope], None]:
-        me = self.names[i]
-        index = {name: k for k, name in enumerate(self.names)}
-
-        def on_state(message: Message, envelope: Envelope) -> None:
-            assert isinstance(message, RobotState)
-            if message.robot != me:
-                k = index[message.robot]
-                self.others[i][k] = (message.x_m, message.y_m, message.radius_m, envelope.t_recv_ns)
-
-        return on_state
-
-    def _broadcast(self, run: RunContext, now_ns: int) -> None:
-        for i, host in enumerate(self.hosts):
-            x, y, yaw = self.pose[i]
-            state = RobotState(
-                now_ns,
-                self.names[i],
-                float(x),
-                float(y),
-                float(yaw),
-                float(self.vel[i, 0]),
-                self.radius,
-            )
-            run.bus.publish(ROBOT_STATES, state, host)
 
     def _status(self, run: RunContext, i: int, state: str, remaining: float) -> None:
         x, y, _ = self.pose[i]
@@ -357,13 +330,9 @@ class NavigationAdapter:
             in_lane = np.zeros(len(points), dtype=bool)
             in_lane[inside] = self.lanes[cells[inside, 1], cells[inside, 0]] != TWO_WAY
             points = points[~in_lane]
-        discs = self._discs(i, now_ns)
+        no_discs = np.zeros((0, 3))
+        discs = no_discs if self.robots_layer is None else self.robots_layer.discs(i, now_ns)
         return points, discs
-
-    def _discs(self, i: int, now_ns: int) -> np.ndarray:
-        timeout = s_to_ns(self.cfg.robots_layer_timeout_s)
-        known = [(x, y, r) for x, y, r, t in self.others[i].values() if now_ns - t <= timeout]
-        return np.array(known, dtype=float).reshape(-1, 3)
 
     def _plan(self, run: RunContext, i: int, now_ns: int, *, replan: bool) -> bool:
         start = time.perf_counter()
@@ -505,7 +474,10 @@ class NavigationAdapter:
             self.pose[:, 0], self.pose[:, 1], self.cfg.lookahead_m
         )
         carrots = keep_right(carrots, moving, self.pose, self.active, self.traffic)
-        discs, disc_start = self._all_discs(now_ns)
+        if self.robots_layer is None:
+            discs, disc_start = np.zeros((0, 3)), np.zeros(len(self.names) + 1, dtype=np.int64)
+        else:
+            discs, disc_start = self.robots_layer.all_discs(now_ns)
         result = dwa_batch(
             self.pose,
             self.vel,
@@ -547,15 +519,6 @@ class NavigationAdapter:
         publish = run.bus.publish
         for i, (vi, wi) in enumerate(zip(v.tolist(), w.tolist(), strict=True)):
             publish(self.cmd_topics[i], Twist(vi, wi), self.hosts[i])
-
-    def _all_discs(self, now_ns: int) -> tuple[np.ndarray, np.ndarray]:
-        n = len(self.names)
-        start = np.zeros(n + 1, dtype=np.int64)
-        if not self.cfg.robots_layer:
-            return np.zeros((0, 3)), start
-        parts = [self._discs(i, now_ns) for i in range(n)]
-        np.cumsum([len(p) for p in parts], out=start[1:])
-        return np.vstack(parts) if parts else np.zeros((0, 3)), start
 
     def _check_arrivals(self, run: RunContext, now_ns: int) -> None:
         gap = np.hypot(*(self.pose[:, :2] - self.goal).T)
@@ -600,25 +563,6 @@ class NavigationAdapter:
         accepted = summary["goals"] - summary["goals_unreachable"]
         summary["goals_missed"] = accepted - summary["arrivals"] - active
         return summary
-
-
-def _lanes_on(layer: StaticCostmap, truth: OccupancyGrid) -> np.ndarray:
-    """The building's one-way lanes on a costmap's cells (two-way where the map reaches past it).
-
-    A robot that maps plans on a grid with a margin around the building; the lanes are laid
-    into it at the building's offset. Both grids share the cell size.
-    """
-    lanes = aisle_lanes(truth.data >= OCCUPIED, truth.resolution_m, LANE_WIDTH_M)
-    offset = np.subtract(truth.origin_xy_m, layer.origin_xy_m) / layer.resolution_m
-    ox, oy = (int(v) for v in np.rint(offset))
-    rows, cols = lanes.shape
-    if ox < 0 or oy < 0 or oy + rows > layer.height or ox + cols > layer.width:
-        raise ValueError(
-            f"the costmap {layer.cost.shape} does not cover the building {lanes.shape}"
-        )
-    placed = np.full(layer.cost.shape, TWO_WAY, dtype=np.uint8)
-    placed[oy : oy + rows, ox : ox + cols] = lanes
-    return placed
 
 
 def _beam_angles(beams: int, fov_rad: float) -> np.ndarray:

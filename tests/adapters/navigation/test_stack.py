@@ -259,7 +259,8 @@ def test_an_unknown_traffic_policy_is_refused_naming_the_key_and_the_choices():
 
 
 def test_robots_that_map_drive_on_the_buildings_lanes_laid_into_their_wider_maps():
-    from adapters.navigation.stack import _lanes_on
+    from adapters.navigation.layers import lanes_on
+    from adapters.navigation.stack import LANE_WIDTH_M
     from cosim.worldfiles import scenario_warehouse
     from models.navigation.costmap import CostmapParams, StaticCostmap
     from models.navigation.lanes import TWO_WAY, aisle_lanes
@@ -270,7 +271,7 @@ def test_robots_that_map_drive_on_the_buildings_lanes_laid_into_their_wider_maps
     margin = np.zeros((truth.data.shape[0] + 20, truth.data.shape[1] + 20), dtype=np.int8)
     wider = OccupancyGrid(0.1, (truth.origin_xy_m[0] - 1.0, truth.origin_xy_m[1] - 1.0), margin)
     layer = StaticCostmap.from_grid(wider, CostmapParams(0.3))
-    placed = _lanes_on(layer, truth)
+    placed = lanes_on(layer, truth, LANE_WIDTH_M)
     assert placed.shape == layer.cost.shape
     assert np.array_equal(placed[10:-10, 10:-10], aisle_lanes(truth.data >= OCCUPIED, 0.1, 2.5))
     assert (placed[:10] == TWO_WAY).all() and (placed[:, -10:] == TWO_WAY).all()
