@@ -15,8 +15,9 @@ rules use them, vectorized over the fleet:
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
+import numba
 import numpy as np
 import numpy.typing as npt
 
@@ -87,22 +88,67 @@ def moving_points(
         params: the rules' parameters.
     """
     owner = np.repeat(np.arange(len(start) - 1), np.diff(start))
-    cells = np.floor((points - np.asarray(origin_xy_m)) / resolution_m).astype(np.int64)
-    rows, cols = static_distance_m.shape[-2:]
-    inside = (cells[:, 0] >= 0) & (cells[:, 0] < cols) & (cells[:, 1] >= 0)
-    inside &= cells[:, 1] < rows
-    clear = np.zeros(len(points), dtype=bool)
-    if static_distance_m.ndim == 3:
-        distance = static_distance_m[owner[inside], cells[inside, 1], cells[inside, 0]]
-    else:
-        distance = static_distance_m[cells[inside, 1], cells[inside, 0]]
-    clear[inside] = distance > params.static_margin_m
-    owner = owner[clear]
-    x, y, yaw = poses[owner].T
-    dx, dy = points[clear, 0] - x, points[clear, 1] - y
-    ahead = dx * np.cos(yaw) + dy * np.sin(yaw)
-    side = -dx * np.sin(yaw) + dy * np.cos(yaw)
-    return MovingPoints(owner, points[clear], ahead, side)
+    grids = static_distance_m if static_distance_m.ndim == 3 else static_distance_m[None]
+    yaw = poses[:, 2]
+    clear = np.empty(len(points), dtype=np.bool_)
+    ahead = np.empty(len(points))
+    side = np.empty(len(points))
+    count = _moving(
+        np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2),
+        owner,
+        np.ascontiguousarray(poses[:, 0]),
+        np.ascontiguousarray(poses[:, 1]),
+        np.cos(yaw),
+        np.sin(yaw),
+        grids,
+        static_distance_m.ndim == 3,
+        float(origin_xy_m[0]),
+        float(origin_xy_m[1]),
+        float(resolution_m),
+        # compared in the grid's float type, as numpy compares a float32 grid with a float
+        grids.dtype.type(params.static_margin_m),
+        clear,
+        ahead,
+        side,
+    )
+    return MovingPoints(owner[clear], points[clear], ahead[:count], side[:count])
+
+
+def _moving_py(
+    points: FloatArray,
+    owner: IntArray,
+    x: FloatArray,
+    y: FloatArray,
+    cos_yaw: FloatArray,
+    sin_yaw: FloatArray,
+    grids: npt.NDArray[np.floating],
+    per_robot: bool,
+    origin_x: float,
+    origin_y: float,
+    resolution_m: float,
+    margin: np.floating,
+    clear: BoolArray,
+    ahead: FloatArray,
+    side: FloatArray,
+) -> int:
+    rows, cols = grids.shape[1], grids.shape[2]
+    k = 0
+    for p in range(points.shape[0]):
+        ix = np.int64(np.floor((points[p, 0] - origin_x) / resolution_m))
+        iy = np.int64(np.floor((points[p, 1] - origin_y) / resolution_m))
+        i = owner[p]
+        clear[p] = False
+        if 0 <= ix < cols and 0 <= iy < rows:
+            clear[p] = grids[i if per_robot else 0, iy, ix] > margin
+        if clear[p]:
+            dx, dy = points[p, 0] - x[i], points[p, 1] - y[i]
+            ahead[k] = dx * cos_yaw[i] + dy * sin_yaw[i]
+            side[k] = -dx * sin_yaw[i] + dy * cos_yaw[i]
+            k += 1
+    return k
+
+
+_moving: Any = numba.njit(cache=True)(_moving_py)
 
 
 def keep_right(

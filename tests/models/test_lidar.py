@@ -2,8 +2,16 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
-from models.lidar import ScanGeometry, apply_sensor_model, beam_directions, cast_reference
+from models.lidar import (
+    ScanGeometry,
+    apply_sensor_model,
+    beam_directions,
+    cast_reference,
+    hits_within,
+)
 from models.world import box_segments
 
 
@@ -133,3 +141,50 @@ def test_the_sensor_model_refuses_draws_of_another_shape():
     normals, uniforms = _draws((2, 4), 5)
     with pytest.raises(ValueError, match=r"draws of shapes \(2, 4\) and \(4,\)"):
         apply_sensor_model(np.full((2, 4), 3.0), geometry, 0.01, 0.0, normals, uniforms[0])
+
+
+def _numpy_hits_within(ranges, seen, poses, angles, within_m):
+    """Hits within range in numpy terms (numpy's promotion rules decide the comparisons)."""
+    keep = np.isfinite(ranges) & (ranges > 0) & (ranges <= within_m) & seen[:, None]
+    r = np.where(keep, ranges, 0.0).astype(np.float64)
+    c, s = np.cos(poses[:, 2:3]), np.sin(poses[:, 2:3])
+    x = poses[:, 0:1] + r * (c * np.cos(angles) - s * np.sin(angles))
+    y = poses[:, 1:2] + r * (s * np.cos(angles) + c * np.sin(angles))
+    start = np.zeros(len(ranges) + 1, dtype=np.int64)
+    np.cumsum(keep.sum(axis=1), out=start[1:])
+    return np.stack([x[keep], y[keep]], axis=1), start
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    robots=st.integers(0, 5),
+    beams=st.integers(1, 40),
+    within_m=st.floats(0.0, 12.0),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_hits_within_range_match_their_numpy_formulation_bit_for_bit(robots, beams, within_m, seed):
+    rng = np.random.default_rng(seed)
+    ranges = rng.uniform(-1.0, 11.0, (robots, beams)).astype(np.float32)
+    specials = np.array([np.nan, np.inf, -np.inf, 0.0, np.float32(within_m)], dtype=np.float32)
+    mask = rng.random(ranges.shape) < 0.3
+    ranges[mask] = rng.choice(specials, int(mask.sum()))
+    seen = rng.random(robots) < 0.8
+    poses = np.column_stack(
+        [rng.uniform(-50, 50, robots), rng.uniform(-50, 50, robots), rng.uniform(-7, 7, robots)]
+    )
+    angles = ScanGeometry(beams, 2 * math.pi, 0.1, 10.0).angles()
+    points, start = hits_within(ranges, seen, poses, np.cos(angles), np.sin(angles), within_m)
+    want_points, want_start = _numpy_hits_within(ranges, seen, poses, angles, within_m)
+    np.testing.assert_array_equal(start, want_start)
+    np.testing.assert_array_equal(points.view(np.int64), want_points.view(np.int64))
+
+
+def test_hits_within_range_leave_out_robots_without_a_scan_and_beams_without_a_hit():
+    angles = ScanGeometry(4, 2 * math.pi, 0.1, 10.0).angles()  # -180, -90, 0, 90 deg
+    ranges = np.array([[1.0, np.inf, 2.0, np.nan], [1.0, 1.0, 1.0, 1.0]], dtype=np.float32)
+    poses = np.array([[1.0, 2.0, 0.0], [0.0, 0.0, 0.0]])
+    points, start = hits_within(
+        ranges, np.array([True, False]), poses, np.cos(angles), np.sin(angles), 1.5
+    )
+    assert list(start) == [0, 1, 1]
+    assert points == pytest.approx(np.array([[0.0, 2.0]]))

@@ -47,3 +47,22 @@ def test_moving_memory_recalls_first_sightings_in_order_on_any_cell_size():
     assert len(memory.recall(5, 0.1)) == 0
     # a coarser grid merges cells: the keys are computed for it, not taken from arrival
     assert memory.recall(0, 2.5) == pytest.approx(np.array([[1.0, 1.0], [3.0, 3.0]]))
+
+
+def test_moving_memory_keeps_what_it_remembers_when_its_buffer_compacts_and_grows():
+    memory = MovingMemory(2_000_000_000, cell_m=0.1)
+    rng = np.random.default_rng(3)
+    kept = []
+    for tick in range(40):  # 400 ms apart: 6 instants live at once, 300-900 points each
+        k = int(rng.integers(300, 900))
+        owner = np.sort(rng.integers(0, 3, k))
+        points = rng.uniform(0, 50, (k, 2))
+        memory.remember(tick * 400_000_000, owner, points)
+        kept.append((tick * 400_000_000, owner, points))
+        now = tick * 400_000_000
+        live = [(o, p) for t, o, p in kept if now - t <= 2_000_000_000]
+        for robot in range(3):
+            every = np.concatenate([p[o == robot] for o, p in live])
+            keys = np.floor(every / 0.1).astype(np.int64)
+            _, first = np.unique(keys[:, 0] * 1_000_003 + keys[:, 1], return_index=True)
+            np.testing.assert_array_equal(memory.recall(robot, 0.1), every[np.sort(first)])
