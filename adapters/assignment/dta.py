@@ -24,6 +24,7 @@ import numpy as np
 
 from adapters.assignment.protocols import (
     AssignmentProtocol,
+    BasisDecoder,
     CbbaProtocol,
     GreedyProtocol,
     SimplexProtocol,
@@ -123,6 +124,7 @@ class DtaAdapter:
         robots, edges = view.robot_graph()
         bound = self.cfg.diameter_bound or diameter(robots, edges)
         self.diameter = int(bound) if math.isfinite(bound) else len(robots) - 1
+        self.decoder = BasisDecoder()
         self.period_ns = period_ns(1000.0 / self.cfg.period_ms)
         self.rebroadcast_ns = s_to_ns(self.cfg.rebroadcast_s)
         # a common bid reward above any travel cost in the hall (paths included)
@@ -220,7 +222,7 @@ class DtaAdapter:
         protocol = self.cfg.protocol
         if protocol == "distributed_simplex":
             robot.protocol = SimplexProtocol(
-                problem, robot.index, robot.name, tasks.epoch, self.diameter
+                problem, robot.index, robot.name, tasks.epoch, self.diameter, self.decoder
             )
         elif protocol == "cbba":
             robot.protocol = CbbaProtocol(

@@ -23,6 +23,30 @@ _KINDS = {int(kind): kind for kind in ColumnKind}
 """Column kinds by wire value: a dict lookup is ~10x cheaper than calling the enum."""
 
 
+class BasisDecoder:
+    """Wire bases turned into :class:`Column` lists, once per sender and basis.
+
+    A robot's basis message is delivered to each of its neighbours every round, and a
+    sender keeps its wire tuple between basis changes: decoding it in every receiver every
+    round built ~2.5 million columns a simulated second in ``fleet50`` (50 robots, 50 tasks,
+    complete graph; 5 of 9 s of wall time). One decoder is shared by the fleet's protocols:
+    a sender's tuple is decoded when it is a new object, and every receiver gets the same
+    list (never modified) until it changes.
+    """
+
+    def __init__(self) -> None:
+        self._last: dict[str, tuple[tuple[tuple[int, int, int, float], ...], list[Column]]] = {}
+
+    def decode(self, message: SimplexBasis) -> list[Column]:
+        """The columns of ``message``'s basis (shared: do not modify)."""
+        known = self._last.get(message.robot)
+        if known is not None and known[0] is message.columns:
+            return known[1]
+        columns = [Column(_KINDS[k], r, t, c) for k, r, t, c in message.columns]
+        self._last[message.robot] = (message.columns, columns)
+        return columns
+
+
 class AssignmentProtocol(Protocol):
     """One robot's side of an assignment protocol in one epoch."""
 
@@ -57,19 +81,26 @@ class SimplexProtocol:
     """Distributed simplex (Buerger et al. 2012): exchange bases, re-solve, halt."""
 
     def __init__(
-        self, problem: AssignmentProblem, robot: int, name: str, epoch: int, diameter: int
+        self,
+        problem: AssignmentProblem,
+        robot: int,
+        name: str,
+        epoch: int,
+        diameter: int,
+        decoder: BasisDecoder | None = None,
     ) -> None:
         self.problem = problem
         self.robot = robot
         self.name = name
         self.epoch = epoch
         self.agent = agent_for(problem, [robot], diameter, epoch)
+        self.decoder = decoder if decoder is not None else BasisDecoder()
         self._columns: tuple[tuple[int, int, int, float], ...] | None = None
 
     def round(self, inbox: list[Message], now_ns: int) -> tuple[Message | None, bool]:
         """Merge neighbours' bases with own columns, re-solve, and send the basis."""
         received = [
-            [Column(_KINDS[k], r, t, c) for k, r, t, c in m.columns]
+            self.decoder.decode(m)
             for m in inbox
             if isinstance(m, SimplexBasis) and m.epoch == self.epoch
         ]

@@ -80,6 +80,9 @@ class SimplexAgent:
         self._basis = identity_basis(shape, unserved_cost)
         self._inverse = np.eye(shape.rows)
         self._candidates: dict[Column, None] = {}
+        # received bases (by identity, held so that ids stay theirs) whose columns are all
+        # candidates: a neighbour resends the same basis object until it changes
+        self._merged: dict[int, Sequence[Column]] = {}
         self.solved = False
         self.rounds = 0
         self.unchanged = 0
@@ -120,16 +123,26 @@ class SimplexAgent:
         for basis in received:
             if len(basis) != m:
                 raise ModelError("received", len(basis), f"bases of {m} columns")
-        columns = dict.fromkeys(chain(self._known, self._basis, *received))
         self.rounds += 1
+        merged = self._merged
         # The basis is lexicographically optimal over the last candidate set, which held
-        # it; over a subset that still holds it, it stays optimal: no need to solve.
+        # it; over a subset that still holds it, it stays optimal: no need to solve. Own
+        # columns and the basis are candidates since the first solve; bases received before
+        # whose columns were all candidates still are (the set only changes on a solve).
+        if self._candidates and all(merged.get(id(b)) is b for b in received):
+            self.solved = False
+            self.pivots = 0
+            self.unchanged += 1
+            return False
+        columns = dict.fromkeys(chain(self._known, self._basis, *received))
         self.solved = not columns.keys() <= self._candidates.keys()
         if not self.solved:
+            merged.update((id(b), b) for b in received)
             self.pivots = 0
             self.unchanged += 1
             return False
         self._candidates = columns
+        self._merged = {id(b): b for b in received}
         solution = lex_simplex(self.shape, columns, self._basis, start_inverse=self._inverse)
         changed = solution.basis != self._basis
         self._basis = solution.basis

@@ -1,8 +1,8 @@
 import numpy as np
 
-from adapters.assignment.protocols import SimplexProtocol
+from adapters.assignment.protocols import BasisDecoder, SimplexProtocol
 from cosim.messages import Message, SimplexBasis
-from models.assignment.problem import AssignmentProblem
+from models.assignment.problem import AssignmentProblem, Column, ColumnKind
 
 
 def test_the_simplex_protocol_sends_its_current_basis_every_round():
@@ -25,3 +25,16 @@ def test_the_simplex_protocol_sends_its_current_basis_every_round():
         inboxes = [[m for j, m in enumerate(sent) if j != i] for i in range(3)]
     assert changes > 0
     assert all(agent.decided for agent in agents)
+
+
+def test_a_basis_is_decoded_once_per_sender_until_its_wire_form_changes():
+    decoder = BasisDecoder()
+    wire = ((0, 1, 2, 3.5), (1, 0, -1, 1e6))
+    first = decoder.decode(SimplexBasis(1, 0, "robot_1", 1, wire))
+    assert first == [Column(ColumnKind(0), 1, 2, 3.5), Column(ColumnKind(1), 0, -1, 1e6)]
+    # the same wire tuple again (the sender kept it): the same list, for every receiver
+    assert decoder.decode(SimplexBasis(2, 0, "robot_1", 2, wire)) is first
+    # an equal tuple that is another object is decoded again, and so is another sender's
+    again = decoder.decode(SimplexBasis(3, 0, "robot_1", 3, tuple(list(wire))))
+    assert again == first and again is not first
+    assert decoder.decode(SimplexBasis(3, 0, "robot_2", 3, wire)) is not first

@@ -177,3 +177,31 @@ def test_the_agent_objective_counts_only_columns_at_one():
     agent = agent_for(problem, range(4), 0)
     agent.merge_and_solve([])
     assert agent.objective() == objective(problem, agent.assignment()) == 3.0
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_bases_resent_as_the_same_objects_give_the_rounds_fresh_copies_give(
+    seed, make_lp, make_graph
+):
+    problem = make_lp(seed)
+    n = len(problem.robots)
+    edges = make_graph(GRAPHS[seed % 3], n, np.random.default_rng(seed + 10**6))
+    neighbours = {
+        i: [j for a, b in edges for i2, j in ((a, b), (b, a)) if i2 == i] for i in range(n)
+    }
+    bound = _diameter(n, edges)
+    shared = [agent_for(problem, [i], bound) for i in range(n)]
+    fresh = [agent_for(problem, [i], bound) for i in range(n)]
+    sent: list[list] = [[] for _ in range(n)]  # what each shared agent sends, kept until it changes
+    for _round in range(ROUNDS_PER_STOPPING_WINDOW * (2 * bound + 1)):
+        inbox_shared = [[sent[j] for j in neighbours[i] if sent[j]] for i in range(n)]
+        inbox_fresh = [[list(fresh[j].basis) for j in neighbours[i] if sent[j]] for i in range(n)]
+        for i in range(n):
+            a = shared[i].merge_and_solve(inbox_shared[i])
+            b = fresh[i].merge_and_solve(inbox_fresh[i])
+            assert (a, shared[i].basis, shared[i].unchanged) == (
+                b,
+                fresh[i].basis,
+                fresh[i].unchanged,
+            )
+        sent = [s if s and s == shared[i].basis else shared[i].basis for i, s in enumerate(sent)]
