@@ -244,30 +244,72 @@ BREAKDOWN = {
 }
 
 
-def fleet50_navigation(repeat: int) -> Result:
-    """fleet50 preset (navigation to random goals): real-time factor and where time goes."""
+def _shares(scenario: cosim.Scenario, breakdown: dict[str, tuple[str, str]]) -> Result:
+    """cProfile shares of wall time of one run, by (file suffix, function) of the breakdown."""
     import cProfile
     import pstats
 
-    scenario = cosim.load_scenario("fleet50", {"scenario.duration_s": 60.0})
-    runs = _rtf_runs(scenario, repeat)
     profiler = cProfile.Profile()
     profiler.enable()
-    result = cosim.run(scenario.with_duration(30.0))
+    result = cosim.run(scenario)
     profiler.disable()
     stats = pstats.Stats(profiler).stats  # type: ignore[attr-defined]
     total = sum(v[2] for v in stats.values())
     shares = {}
-    for label, (path, func) in BREAKDOWN.items():
+    for label, (path, func) in breakdown.items():
         cum = sum(
             v[3] for (file, _line, name), v in stats.items() if file.endswith(path) and name == func
         )
         shares[label] = round(cum / total, 3) if total else None
+    return {"summary": result.summary, "shares": shares}
+
+
+def fleet50_navigation(repeat: int) -> Result:
+    """fleet50 preset (navigation to random goals): real-time factor and where time goes."""
+    scenario = cosim.load_scenario("fleet50", {"scenario.duration_s": 60.0})
+    runs = _rtf_runs(scenario, repeat)
+    profiled = _shares(scenario.with_duration(30.0), BREAKDOWN)
     return {
         **runs,
-        "arrivals_last": result.summary["arrivals"],
-        "breakdown_share_of_wall_time": shares,
+        "arrivals_last": profiled["summary"]["arrivals"],
+        "breakdown_share_of_wall_time": profiled["shares"],
         "breakdown_note": "cProfile shares of a 30 s run (profiling slows the run ~30 %)",
+    }
+
+
+FULL_STACK = {
+    "robots.driver": "tasks",
+    "tasks.initial": 50,
+    "assignment.protocol": "distributed_simplex",
+    "mapping.enabled": True,
+    "odometry.drift": 0.02,
+}
+"""fleet50 with the whole stack: 50 tasks assigned by distributed simplex (a new one for each
+done), every robot mapping as it drives on drifting odometry, navigation on its own map."""
+
+FULL_STACK_BREAKDOWN = {
+    "task assignment rounds (protocol, broadcasts)": ("adapters/assignment/dta.py", "_round_of"),
+    "  distributed simplex merge and solve": ("models/assignment/dsimplex.py", "merge_and_solve"),
+    "mapping: scan matching (every scan)": ("adapters/mapping/mapper.py", "on_scan"),
+    "mapping: map updates (every 5 s)": ("adapters/mapping/mapper.py", "_publish_maps"),
+    **BREAKDOWN,
+}
+
+
+def fleet50_full_stack(repeat: int) -> Result:
+    """fleet50 with navigation, task assignment and mapping: real-time factor, where time goes."""
+    scenario = cosim.load_scenario("fleet50", {"scenario.duration_s": 30.0, **FULL_STACK})
+    runs = _rtf_runs(scenario, repeat)
+    profiled = _shares(scenario.with_duration(15.0), FULL_STACK_BREAKDOWN)
+    summary = profiled["summary"]
+    return {
+        **runs,
+        "overrides": FULL_STACK,
+        "target_real_time_factor": 20.0,
+        "arrivals_last": summary.get("arrivals"),
+        "path_length_ratio_last": summary.get("path_length_ratio"),
+        "breakdown_share_of_wall_time": profiled["shares"],
+        "breakdown_note": "cProfile shares of a 15 s run (profiling slows the run ~30 %)",
     }
 
 
@@ -332,6 +374,7 @@ SUITES: dict[str, Callable[[int], Result]] = {
     "network_end_to_end": network_end_to_end,
     "planner": planner_ms,
     "fleet50_navigation": fleet50_navigation,
+    "fleet50_full_stack": fleet50_full_stack,
     "dwa": dwa_us_per_robot,
     "assignment": assignment_solve_stats,
     "study": study_throughput,
