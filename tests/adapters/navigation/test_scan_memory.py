@@ -49,7 +49,7 @@ def test_moving_memory_recalls_first_sightings_in_order_on_any_cell_size():
     assert memory.recall(0, 2.5) == pytest.approx(np.array([[1.0, 1.0], [3.0, 3.0]]))
 
 
-def test_moving_memory_keeps_what_it_remembers_when_its_buffer_compacts_and_grows():
+def test_moving_memory_recalls_exactly_what_a_sort_based_unique_keeps_over_many_instants():
     memory = MovingMemory(2_000_000_000, cell_m=0.1)
     rng = np.random.default_rng(3)
     kept = []
