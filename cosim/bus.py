@@ -24,7 +24,7 @@ import simpy
 
 from cosim.hosts import HostId
 from cosim.kernel import Kernel, Stage
-from cosim.link import DeliveryStatus, IdealLink, Link, Transfer
+from cosim.link import DeliveryStatus, IdealLink, Link
 from cosim.messages import Message
 
 
@@ -187,8 +187,7 @@ class Bus:
         now = int(self.kernel.env.now)
         nbytes = message.size_bytes()
         if remote:
-            for transfer in self.link.transmit(now, src, remote, nbytes, topic):
-                self._dispatch(topic, message, src, now, nbytes, transfer)
+            self._dispatch(topic, message, src, now, nbytes, remote)
         if local:
             if self.tap is not None:
                 self.tap.on_transfer(now, now, src, src, topic, nbytes, DeliveryStatus.DELIVERED)
@@ -203,24 +202,39 @@ class Bus:
         src: HostId,
         t_sent_ns: int,
         nbytes: int,
-        transfer: Transfer,
+        remote: tuple[HostId, ...],
     ) -> None:
-        if self.tap is not None:
-            self.tap.on_transfer(
-                t_sent_ns, transfer.t_recv_ns, src, transfer.dst, topic, nbytes, transfer.status
-            )
-        if transfer.status is not DeliveryStatus.DELIVERED or transfer.t_recv_ns is None:
-            return
-        envelope = Envelope(topic, src, t_sent_ns, transfer.t_recv_ns)
+        """Hand ``message`` to the link for ``remote`` and schedule what it delivers.
+
+        Deliveries that arrive at the same instant share one kernel event (a broadcast on
+        an ideal link: one event for 49 neighbours instead of 49), delivered in the link's
+        order. The order of everything is as with an event each: events of one instant and
+        stage run in scheduling order, and these were scheduled back to back.
+        """
+        tap = self.tap
+        arrivals: dict[int, list[HostId]] = {}
+        for transfer in self.link.transmit(t_sent_ns, src, remote, nbytes, topic):
+            if tap is not None:
+                tap.on_transfer(
+                    t_sent_ns, transfer.t_recv_ns, src, transfer.dst, topic, nbytes, transfer.status
+                )
+            if transfer.status is not DeliveryStatus.DELIVERED or transfer.t_recv_ns is None:
+                continue
+            if transfer.t_recv_ns < t_sent_ns:
+                delay = transfer.t_recv_ns - t_sent_ns
+                raise ValueError(f"link delivered {topic} before it was sent ({delay} ns)")
+            arrivals.setdefault(transfer.t_recv_ns, []).append(transfer.dst)
         by_host = self._topics[topic]
-        dst = transfer.dst
+        for t_recv_ns, hosts in arrivals.items():
+            envelope = Envelope(topic, src, t_sent_ns, t_recv_ns)
 
-        def deliver(_event: simpy.Event) -> None:
-            # subscribers as they are on arrival, as a ROS subscription would be
-            for callback in tuple(by_host.get(dst, ())):
-                callback(message, envelope)
+            def deliver(
+                _event: simpy.Event, hosts: list[HostId] = hosts, envelope: Envelope = envelope
+            ) -> None:
+                for dst in hosts:
+                    # subscribers as they are on arrival, as a ROS subscription would be
+                    for callback in tuple(by_host.get(dst, ())):
+                        callback(message, envelope)
 
-        delay = transfer.t_recv_ns - t_sent_ns
-        if delay < 0:
-            raise ValueError(f"link delivered {topic} before it was sent ({delay} ns)")
-        self.kernel.timeout(delay, Stage.DELIVERY).callbacks.append(deliver)
+            delay = t_recv_ns - t_sent_ns
+            self.kernel.timeout(delay, Stage.DELIVERY).callbacks.append(deliver)

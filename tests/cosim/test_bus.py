@@ -148,3 +148,67 @@ def test_a_topic_advertised_with_two_types_is_refused():
     with pytest.raises(ValueError, match="advertised as Twist"):
         bus.advertise("/cmd", Message)
     assert list(bus.advertised()) == ["/cmd"]
+
+
+class ListedDelayLink:
+    """A test link: host ``h`` receives ``delays[h]`` ns after sending (None: lost)."""
+
+    def __init__(self, delays: dict[HostId, int | None]) -> None:
+        self.delays = delays
+
+    def transmit(
+        self, t_ns: int, src: HostId, dsts: Sequence[HostId], nbytes: int, topic: str
+    ) -> Sequence[Transfer]:
+        out = []
+        for d in dsts:
+            delay = self.delays[d]
+            if delay is None:
+                out.append(Transfer(d, DeliveryStatus.LOST, None))
+            else:
+                out.append(Transfer(d, DeliveryStatus.DELIVERED, t_ns + delay))
+        return out
+
+
+def test_a_broadcast_arriving_at_one_instant_is_one_kernel_event_delivered_in_link_order():
+    hosts = [HostId(f"h{i}") for i in range(6)]
+    delays: dict[HostId, int | None] = {h: 0 for h in hosts}
+    delays[hosts[2]] = None  # lost
+    delays[hosts[4]] = 3_000_000  # later
+    kernel = Kernel()
+    bus = Bus(kernel, ListedDelayLink(delays))
+    got: list[tuple[int, str, Envelope]] = []
+    for h in hosts:
+        bus.subscribe("/t", h, lambda m, e, h=h: got.append((kernel.now_ns, h, e)))
+    # another delivery at the same instant and stage, scheduled after the broadcast
+    bus.publish("/t", Twist(0.0, 0.0), hosts[0])
+    kernel.at(
+        0, lambda: got.append((kernel.now_ns, "after", Envelope("", A, 0, 0))), Stage.DELIVERY
+    )
+    kernel.run(10_000_000)
+    assert [(t, h) for t, h, _ in got] == [
+        (0, "h0"),  # the publisher's own subscriber, at once
+        (0, "h1"),
+        (0, "h3"),
+        (0, "h5"),
+        (0, "after"),
+        (3_000_000, "h4"),
+    ]
+    assert got[1][2] == Envelope("/t", hosts[0], 0, 0)
+    assert got[-1][2] == Envelope("/t", hosts[0], 0, 3_000_000)
+    assert kernel.events_processed == 3  # the instant's deliveries, 'after', the late one
+
+
+def test_a_host_subscribing_while_a_broadcast_is_delivered_gets_it_if_it_arrives_later():
+    kernel = Kernel()
+    bus = Bus(kernel, ListedDelayLink({B: 0, C: 1_000}))
+    got: list[str] = []
+
+    def on_b(message: Message, envelope: Envelope) -> None:
+        got.append("b")
+        bus.subscribe("/t", C, lambda m, e: got.append("c late"))
+
+    bus.subscribe("/t", B, on_b)
+    bus.subscribe("/t", C, lambda m, e: got.append("c"))
+    bus.publish("/t", Twist(0.0, 0.0), A)
+    kernel.run(10_000)
+    assert got == ["b", "c", "c late"]
