@@ -61,6 +61,15 @@ class _Interner:
             self.values.append(value)
         return code
 
+    def codes_of(self, values: Sequence[str]) -> npt.NDArray[np.int32]:
+        """The codes of ``values``, new values coded in order of first appearance.
+
+        A ``str`` subclass (a ``StrEnum`` member) is coded as its plain string value.
+        """
+        for value in dict.fromkeys(values):  # the distinct values, in order
+            self.code(str(value))
+        return np.fromiter(map(self.codes.__getitem__, values), np.int32, len(values))
+
     def categorical(self, codes: npt.NDArray[np.int32]) -> pd.Categorical[str]:
         return pd.Categorical.from_codes(codes, categories=pd.Index(self.values))
 
@@ -198,11 +207,11 @@ class Recorder:
             {
                 "t_sent": np.array(t_sent, dtype=np.int64),
                 "t_recv": np.array(t_recv, dtype=np.int64),
-                "src": np.array([hosts.code(h) for h in src], dtype=np.int32),
-                "dst": np.array([hosts.code(h) for h in dst], dtype=np.int32),
-                "topic": np.array([topics.code(t) for t in topic], dtype=np.int32),
+                "src": hosts.codes_of(src),
+                "dst": hosts.codes_of(dst),
+                "topic": topics.codes_of(topic),
                 "bytes": np.array(nbytes, dtype=np.int64),
-                "status": np.array([statuses.code(str(v)) for v in status], dtype=np.int32),
+                "status": statuses.codes_of(status),
             }
         )
         self._pending = []

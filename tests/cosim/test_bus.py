@@ -212,3 +212,22 @@ def test_a_host_subscribing_while_a_broadcast_is_delivered_gets_it_if_it_arrives
     bus.publish("/t", Twist(0.0, 0.0), A)
     kernel.run(10_000)
     assert got == ["b", "c", "c late"]
+
+
+def test_the_recorder_codes_hosts_topics_and_statuses_as_plain_strings_in_order_of_arrival():
+    recorder = Recorder()
+    rows = [
+        (B, A, "/y", DeliveryStatus.LOST, None),
+        (A, C, "/x", DeliveryStatus.DELIVERED, 7),
+        (B, B, "/y", DeliveryStatus.DELIVERED, 3),
+    ]
+    for src, dst, topic, status, t_recv in rows:
+        recorder.on_transfer(1, t_recv, src, dst, topic, 10, status)
+    frame = recorder.messages_frame()
+    assert list(frame["src_host"]) == ["b", "a", "b"]
+    assert list(frame["dst_host"]) == ["a", "c", "b"]
+    assert list(frame["topic"]) == ["/y", "/x", "/y"]
+    assert list(frame["status"]) == ["lost", "delivered", "delivered"]
+    categories = list(frame["status"].cat.categories)
+    assert categories == ["lost", "delivered"]
+    assert all(type(c) is str for c in categories)
