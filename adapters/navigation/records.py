@@ -15,6 +15,10 @@ import numpy as np
 from cosim.records import Recorder
 from cosim.timebase import NS_PER_S
 
+STUCK_KINDS = ("halted", "detoured", "slowed")
+"""Why a robot reported ``stuck``: it hardly moved, its way grew, or it drove without
+getting nearer (summary keys ``stuck_halted``, ``stuck_detoured``, ``stuck_slowed``)."""
+
 NAV_COLUMNS = (
     "t_s",
     "robot",
@@ -51,6 +55,7 @@ class NavRecords:
         self.times_s: list[float] = []
         self.ratios: list[float] = []
         self.counts: dict[str, int] = {}
+        self.stuck_kinds: dict[str, int] = {}
 
     def row(
         self,
@@ -80,6 +85,10 @@ class NavRecords:
             text = f"goal ({goal_x_m:.2f}, {goal_y_m:.2f})" + (f": {detail}" if detail else "")
             self.recorder.event(t_ns, self.names[i], event, text)
 
+    def stuck(self, kind: str) -> None:
+        """Count a ``stuck`` report by its kind, one of :data:`STUCK_KINDS`."""
+        self.stuck_kinds[kind] = self.stuck_kinds.get(kind, 0) + 1
+
     def start_goal(self, i: int, t_ns: int, driven_m: float, shortest_m: float) -> None:
         """Remember when and where a goal started (for time to goal and path ratio)."""
         self.goal_t0_ns[i] = t_ns
@@ -103,6 +112,7 @@ class NavRecords:
             "mean_time_to_goal_s": round(float(np.mean(self.times_s)), 6) if self.times_s else None,
             "path_length_ratio": round(float(np.mean(self.ratios)), 6) if self.ratios else None,
             "deadlocks": counts.get("stuck", 0),
+            **{f"stuck_{kind}": self.stuck_kinds.get(kind, 0) for kind in STUCK_KINDS},
             "goals_unreachable": counts.get("unreachable", 0),
             "replans": counts.get("replan", 0),
             "recoveries": counts.get("recovery", 0),

@@ -179,3 +179,31 @@ class Recovery:
         back = np.clip(points[:, 0], -BACK_UP_ROOM_M, 0.0)
         gap = np.hypot(points[:, 0] - back, points[:, 1])
         return bool(gap.min() > self.radius_m + BACK_UP_MARGIN_M)
+
+
+STUCK_HALTED_M = 1.0
+"""A ``stuck`` robot that drove less than this since its last progress was halted (m)."""
+STUCK_DETOURED_M = 5.0
+"""A ``stuck`` robot that drove more, with a way left longer than its best by more than
+this, was detoured (m)."""
+
+
+def stuck_kind(driven_m: float, left_m: float, best_m: float) -> tuple[str, str]:
+    """Why a robot made no progress: ``halted``, ``detoured`` or ``slowed``, and the figures.
+
+    Args:
+        driven_m: distance it drove since its last progress (m).
+        left_m: length of the way it has left (m).
+        best_m: the shortest way left it had (m).
+
+    Returns:
+        ``(kind, figures)``: *halted* when it hardly moved (blocked, or waiting), *detoured*
+        when it drove but its way is now much longer than it was (planned round something),
+        *slowed* when it drove without getting nearer (crawling in a crowd, dodging).
+    """
+    figures = f"drove {driven_m:.1f} m, {left_m:.1f} m to go, best {best_m:.1f} m"
+    if driven_m < STUCK_HALTED_M:
+        return "halted", figures
+    if left_m > best_m + STUCK_DETOURED_M:
+        return "detoured", figures
+    return "slowed", figures

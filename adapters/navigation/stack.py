@@ -31,7 +31,7 @@ from adapters.naming import topic
 from adapters.navigation.layers import StaticLayers, lanes_on
 from adapters.navigation.localization import MeasuredPoses
 from adapters.navigation.records import NavRecords
-from adapters.navigation.recovery import Recovery, StallWatch
+from adapters.navigation.recovery import Recovery, StallWatch, stuck_kind
 from adapters.navigation.robots_layer import RobotsLayer
 from adapters.navigation.scan_memory import MovingMemory, ScanMemory
 from cosim.adapter import RunContext
@@ -166,6 +166,7 @@ class NavigationAdapter:
         self.next_plan_ns = np.zeros(n, dtype=np.int64)
         self.best_remaining = np.full(n, np.inf)
         self.progress_ns = np.zeros(n, dtype=np.int64)
+        self.progress_driven_m = np.zeros(n)  # distance driven at the last progress
         self.stuck = np.zeros(n, dtype=bool)
         self.robots_layer: RobotsLayer | None = None
         if cfg.robots_layer:
@@ -301,6 +302,7 @@ class NavigationAdapter:
         self.stuck[i] = False
         self.best_remaining[i] = math.inf
         self.progress_ns[i] = now
+        self.progress_driven_m[i] = self.fleet.distance_m[i]
         self.recovery.reset(i)
         self.stalls.reset(i, self.pose[i], now)
         self.records.start_goal(i, now, float(self.fleet.distance_m[i]), shortest)
@@ -534,19 +536,26 @@ class NavigationAdapter:
         improved = self.active & (remaining < self.best_remaining - PROGRESS_M)
         self.best_remaining[improved] = remaining[improved]
         self.progress_ns[improved] = now_ns
+        self.progress_driven_m[improved] = self.fleet.distance_m[improved]
         self.stuck[improved] = False
         timeout = s_to_ns(self.cfg.stuck_timeout_s)
         late = self.active & ~self.stuck & (now_ns - self.progress_ns >= timeout)
         for i in np.flatnonzero(late).tolist():
             self.stuck[i] = True
+            kind, why = stuck_kind(
+                float(self.fleet.distance_m[i] - self.progress_driven_m[i]),
+                float(remaining[i]),
+                float(self.best_remaining[i]),
+            )
             self.records.row(
                 now_ns,
                 i,
                 "stuck",
                 self.goal[i, 0],
                 self.goal[i, 1],
-                detail=f"no progress for {self.cfg.stuck_timeout_s:g} s",
+                detail=f"no progress for {self.cfg.stuck_timeout_s:g} s: {kind} ({why})",
             )
+            self.records.stuck(kind)
             self._status(run, i, "stuck", float(remaining[i]))
 
     def _progress(self, run: RunContext, now_ns: int) -> None:

@@ -1,6 +1,7 @@
 import numpy as np
+import pytest
 
-from adapters.navigation.recovery import STALL_M, STALL_S, StallWatch
+from adapters.navigation.recovery import STALL_M, STALL_S, StallWatch, stuck_kind
 from cosim.timebase import s_to_ns
 
 TICK_NS = s_to_ns(0.1)
@@ -52,3 +53,21 @@ def test_a_robot_creeping_slower_than_the_threshold_stalls_and_a_reset_restarts_
     assert stalled[0]
     watch.reset(0, poses(STALL_S)[0], ticks * TICK_NS)  # a new goal
     assert not watch.update((ticks + 1) * TICK_NS, poses(STALL_S + 0.1), active)[0]
+
+
+@pytest.mark.parametrize(
+    ("driven_m", "left_m", "best_m", "kind"),
+    [
+        (0.0, 12.0, 12.0, "halted"),  # boxed in
+        (0.9, 30.0, 12.0, "halted"),  # replanned long but stood still
+        (14.0, 24.0, 12.0, "detoured"),  # drove round a rack, the way grew by 12 m
+        (10.0, 12.1, 12.0, "slowed"),  # drove 10 m without getting nearer
+        (2.0, 16.9, 12.0, "slowed"),  # a detour of less than 5 m
+    ],
+)
+def test_a_stuck_report_says_whether_the_robot_halted_detoured_or_slowed(
+    driven_m, left_m, best_m, kind
+):
+    got, figures = stuck_kind(driven_m, left_m, best_m)
+    assert got == kind
+    assert figures == f"drove {driven_m:.1f} m, {left_m:.1f} m to go, best {best_m:.1f} m"

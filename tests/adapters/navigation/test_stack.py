@@ -202,6 +202,11 @@ def test_a_boxed_in_robot_reports_stuck_and_recovers_when_the_others_leave():
     assert 5.0 <= stuck_t < 12.0 < arrived_t
     assert result.summary["collisions"] == 0
     assert result.summary["deadlocks"] == 1
+    # boxed in, it hardly moved: the report says so
+    assert (result.summary["stuck_halted"], result.summary["stuck_detoured"]) == (1, 0)
+    nav = result.tables["navigation"]
+    (detail,) = nav[nav["event"] == "stuck"]["detail"]
+    assert detail.startswith("no progress for 5 s: halted (drove 0.")
 
 
 def test_the_robots_layer_sends_poses_over_the_network_and_keeps_robots_apart():
