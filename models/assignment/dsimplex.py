@@ -110,7 +110,9 @@ class SimplexAgent:
         error). Calling this after :attr:`converged` is harmless: the basis stays.
 
         Args:
-            received: the neighbours' bases of this epoch, each m columns.
+            received: the neighbours' bases of this epoch, each m columns. A sequence
+                passed again (the same object) is taken to be unchanged and not read again
+                when it was merged before (wire bases are decoded once and shared).
 
         Returns:
             Whether the basis changed.
