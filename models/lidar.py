@@ -307,3 +307,79 @@ def _hits_within_py(
 
 
 _hits_within: Any = numba.njit(cache=True)(_hits_within_py)
+
+
+def seen_beyond(
+    pose: FloatArray,
+    ranges: npt.NDArray[np.float32],
+    angle_min_rad: float,
+    increment_rad: float,
+    range_max_m: float,
+    points: FloatArray,
+    tolerance_m: float,
+) -> npt.NDArray[np.bool_]:
+    """Which points a scan sees free space beyond: its beam towards each passes it.
+
+    A point is seen through when it lies within the maximum range and the beam nearest its
+    bearing reads more than its distance plus ``tolerance_m``: no return counts as free up
+    to the maximum range, a return below the minimum range as nothing seen, a dropout
+    (``nan``) as nothing known. One compiled pass with numpy's operations in numpy's order
+    (the same answers to the bit as the array formulation it replaces).
+
+    Args:
+        pose: ``x, y, yaw`` the scan was taken from, in ``map`` (m, rad).
+        ranges: (b,) the scan's ranges (m), as in ``LaserScan``.
+        angle_min_rad: angle of beam 0 in the sensor frame (rad).
+        increment_rad: angle between beams (rad).
+        range_max_m: the lidar's maximum range (m).
+        points: (k, 2) points in ``map`` (m).
+        tolerance_m: how far beyond a point the beam must reach (m).
+
+    Returns:
+        (k,) True where the scan sees through the point.
+    """
+    out = np.zeros(len(points), dtype=np.bool_)
+    if len(points):
+        _seen_beyond(
+            float(pose[0]),
+            float(pose[1]),
+            float(pose[2]),
+            ranges,
+            float(angle_min_rad),
+            float(increment_rad),
+            float(range_max_m),
+            np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2),
+            float(tolerance_m),
+            out,
+        )
+    return out
+
+
+def _seen_beyond_py(
+    x: float,
+    y: float,
+    yaw: float,
+    ranges: npt.NDArray[np.float32],
+    angle_min: float,
+    increment: float,
+    range_max: float,
+    points: FloatArray,
+    tolerance: float,
+    out: npt.NDArray[np.bool_],
+) -> None:
+    beams = ranges.shape[0]
+    turn = 2 * math.pi
+    for p in range(points.shape[0]):
+        dx, dy = points[p, 0] - x, points[p, 1] - y
+        dist = np.hypot(dx, dy)
+        bearing = (np.arctan2(dy, dx) - yaw - angle_min) % turn
+        beam = np.int64(np.rint(bearing / increment))
+        seen = np.float64(ranges[min(beam, beams - 1)])
+        if seen == np.inf:
+            seen = range_max
+        elif seen == -np.inf:
+            seen = 0.0
+        out[p] = beam < beams and dist < range_max and seen > dist + tolerance
+
+
+_seen_beyond: Any = numba.njit(cache=True)(_seen_beyond_py)

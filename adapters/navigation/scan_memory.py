@@ -18,7 +18,7 @@ import numpy as np
 import numpy.typing as npt
 
 from models.arrays import FloatArray, IntArray
-from models.lidar import hits_within
+from models.lidar import hits_within, seen_beyond
 from models.navigation.sightings import cell_keys, first_per_cell
 
 
@@ -62,21 +62,17 @@ class ScanMemory:
         self, robot: int, points: FloatArray, tolerance_m: float
     ) -> npt.NDArray[np.bool_]:
         """Which points ``robot``'s latest scan sees free space beyond (by ``tolerance_m``)."""
-        if not self.seen[robot] or not len(points):
+        if not self.seen[robot]:
             return np.zeros(len(points), dtype=bool)
-        x, y, yaw = self.poses[robot]
-        dx, dy = points[:, 0] - x, points[:, 1] - y
-        dist = np.hypot(dx, dy)
-        bearing = (np.arctan2(dy, dx) - yaw - self.angle_min) % (2 * math.pi)
-        beam = np.rint(bearing / self.increment).astype(np.int64)
-        inside = beam < self.beams
-        seen = self.ranges[robot, np.minimum(beam, self.beams - 1)].astype(np.float64)
-        # no return: free up to the maximum range; a return below the minimum: nothing seen
-        seen = np.where(seen == np.inf, self.range_max_m, seen)
-        seen = np.where(seen == -np.inf, 0.0, seen)
-        through: npt.NDArray[np.bool_] = inside & (dist < self.range_max_m)
-        through &= seen > dist + tolerance_m
-        return through
+        return seen_beyond(
+            self.poses[robot],
+            self.ranges[robot],
+            self.angle_min,
+            self.increment,
+            self.range_max_m,
+            points,
+            tolerance_m,
+        )
 
     def local_points(self, robot: int) -> FloatArray:
         """Hits of ``robot``'s latest scan in its ``base_link`` frame, (k, 2) (m)."""

@@ -11,6 +11,7 @@ from models.lidar import (
     beam_directions,
     cast_reference,
     hits_within,
+    seen_beyond,
 )
 from models.world import box_segments
 
@@ -188,3 +189,38 @@ def test_hits_within_range_leave_out_robots_without_a_scan_and_beams_without_a_h
     )
     assert list(start) == [0, 1, 1]
     assert points == pytest.approx(np.array([[0.0, 2.0]]))
+
+
+def _numpy_seen_beyond(pose, ranges, angle_min, increment, range_max, points, tolerance):
+    """Seen-through points in numpy terms."""
+    x, y, yaw = pose
+    dx, dy = points[:, 0] - x, points[:, 1] - y
+    dist = np.hypot(dx, dy)
+    bearing = (np.arctan2(dy, dx) - yaw - angle_min) % (2 * math.pi)
+    beam = np.rint(bearing / increment).astype(np.int64)
+    inside = beam < len(ranges)
+    seen = ranges[np.minimum(beam, len(ranges) - 1)].astype(np.float64)
+    seen = np.where(seen == np.inf, range_max, seen)
+    seen = np.where(seen == -np.inf, 0.0, seen)
+    return inside & (dist < range_max) & (seen > dist + tolerance)
+
+
+@settings(max_examples=80, deadline=None)
+@given(
+    beams=st.integers(2, 400),  # the navigation's scan memory takes 1 rad for a single beam
+    full=st.booleans(),
+    count=st.integers(0, 60),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_points_seen_through_match_their_numpy_formulation(beams, full, count, seed):
+    rng = np.random.default_rng(seed)
+    geometry = ScanGeometry(beams, 2 * math.pi if full else 4.0, 0.1, 10.0)
+    ranges = rng.uniform(-1.0, 11.0, beams).astype(np.float32)
+    specials = np.array([np.nan, np.inf, -np.inf], dtype=np.float32)
+    mask = rng.random(beams) < 0.3
+    ranges[mask] = rng.choice(specials, int(mask.sum()))
+    pose = np.array([rng.uniform(-5, 5), rng.uniform(-5, 5), rng.uniform(-7, 7)])
+    points = pose[:2] + rng.uniform(-12, 12, (count, 2))
+    args = (geometry.angle_min_rad, geometry.angle_increment_rad, 10.0, points, 0.2)
+    got = seen_beyond(pose, ranges, *args)
+    np.testing.assert_array_equal(got, _numpy_seen_beyond(pose, ranges, *args))
