@@ -374,7 +374,7 @@ def _seen_beyond_py(
         dist = np.hypot(dx, dy)
         bearing = (np.arctan2(dy, dx) - yaw - angle_min) % turn
         beam = np.int64(np.rint(bearing / increment))
-        seen = np.float64(ranges[min(beam, beams - 1)])
+        seen = float(ranges[min(beam, beams - 1)])
         if seen == np.inf:
             seen = range_max
         elif seen == -np.inf:

@@ -123,13 +123,11 @@ class FleetAdapter:
         odom = self.odom.tolist()
         v = state.v.tolist()
         w = state.w.tolist()
-        publish = run.bus.publish
-        for i, host in enumerate(self.hosts):
-            x, y, yaw = odom[i]
-            frame, child = self._frames[i]
-            publish(
-                self._odom_topics[i], Odometry(now_ns, frame, child, x, y, yaw, v[i], w[i]), host
-            )
+        messages = [
+            Odometry(now_ns, frame, child, x, y, yaw, vi, wi)
+            for (frame, child), (x, y, yaw), vi, wi in zip(self._frames, odom, v, w, strict=True)
+        ]
+        run.bus.publish_many(self._odom_topics, messages, self.hosts)
 
     def finish(self, run: RunContext) -> Mapping[str, Any]:
         """Robots, distance driven and the final odometry error."""

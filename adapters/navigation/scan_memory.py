@@ -11,7 +11,6 @@ layer already).
 
 from __future__ import annotations
 
-import math
 from collections import deque
 
 import numpy as np

@@ -518,9 +518,8 @@ class NavigationAdapter:
                 now_ns, i, "recovery", self.goal[i, 0], self.goal[i, 1], detail=kind
             ),
         )
-        publish = run.bus.publish
-        for i, (vi, wi) in enumerate(zip(v.tolist(), w.tolist(), strict=True)):
-            publish(self.cmd_topics[i], Twist(vi, wi), self.hosts[i])
+        commands = [Twist(vi, wi) for vi, wi in zip(v.tolist(), w.tolist(), strict=True)]
+        run.bus.publish_many(self.cmd_topics, commands, self.hosts)
 
     def _check_arrivals(self, run: RunContext, now_ns: int) -> None:
         gap = np.hypot(*(self.pose[:, :2] - self.goal).T)

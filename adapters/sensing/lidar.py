@@ -68,6 +68,7 @@ class LidarAdapter:
         self.topics = [topic(name, "scan") for name in self.fleet.names]
         self._own = np.arange(len(names), dtype=np.int64)  # each robot's own circle
         self._frames = [f"{name}/laser" for name in names]
+        self._hosts = [HostId(name) for name in names]
         self.scans = 0
         if cfg.beams > 0:
             for name in self.topics:
@@ -100,22 +101,14 @@ class LidarAdapter:
             exact, geometry, self.noise_std_m, self.dropout_prob, normals, uniforms
         )
         angle_min, increment = geometry.angle_min_rad, geometry.angle_increment_rad
-        for i, name in enumerate(fleet.names):
-            ranges = scans[i]
-            run.bus.publish(
-                self.topics[i],
-                LaserScan(
-                    now_ns,
-                    self._frames[i],
-                    angle_min,
-                    increment,
-                    geometry.range_min_m,
-                    geometry.range_max_m,
-                    scan_time_s,
-                    ranges,
-                ),
-                HostId(name),
+        range_min, range_max = geometry.range_min_m, geometry.range_max_m
+        messages = [
+            LaserScan(
+                now_ns, frame, angle_min, increment, range_min, range_max, scan_time_s, ranges
             )
+            for frame, ranges in zip(self._frames, scans, strict=True)
+        ]
+        run.bus.publish_many(self.topics, messages, self._hosts)
         self.scans += 1
 
     def finish(self, run: RunContext) -> Mapping[str, Any]:

@@ -231,3 +231,40 @@ def test_the_recorder_codes_hosts_topics_and_statuses_as_plain_strings_in_order_
     categories = list(frame["status"].cat.categories)
     assert categories == ["lost", "delivered"]
     assert all(type(c) is str for c in categories)
+
+
+def _traffic(batched: bool) -> tuple[list[tuple[int, str, str, Envelope]], list[str], object]:
+    """Three topics from three hosts, local and remote subscribers, a monitor and a drop."""
+    kernel = Kernel()
+    recorder = Recorder()
+    bus = Bus(kernel, FixedDelayLink(1_000), tap=recorder)
+    got: list[tuple[int, str, str, Envelope]] = []
+    seen: list[str] = []
+    for topic_name, hosts in (("/x", (A, B)), ("/y", (B, C)), ("/z", ())):
+        for host in hosts:
+            bus.subscribe(
+                topic_name, host, lambda m, e, h=host: got.append((kernel.now_ns, h, str(m), e))
+            )
+    bus.monitor("/y", lambda t, m, src, now: seen.append(f"{t} {m} {src} {now}"))
+    topics = ["/x", "/y", "/z", "/x"]
+    messages = [Twist(float(k), 0.0) for k in range(4)]
+    sources = [A, A, B, C]
+
+    def send() -> None:
+        if batched:
+            bus.publish_many(topics, messages, sources)
+        else:
+            for t, m, s in zip(topics, messages, sources, strict=True):
+                bus.publish(t, m, s)
+
+    kernel.at(5_000, send)
+    kernel.run(10_000)
+    return got, seen, recorder.messages_frame()
+
+
+def test_publishing_many_at_once_is_publishing_each_in_turn():
+    got, seen, frame = _traffic(batched=True)
+    want_got, want_seen, want_frame = _traffic(batched=False)
+    assert got == want_got and seen == want_seen
+    assert len(got) == 5  # /x: a at once, b remote; /y: b remote (c lost); /x from c: a, b
+    assert frame.equals(want_frame)
