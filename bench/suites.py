@@ -240,7 +240,8 @@ BREAKDOWN = {
     "  local control (DWA kernel)": ("models/navigation/dwa.py", "dwa_batch"),
     "physics tick (kinematics, collisions, odometry)": ("adapters/fleet/motion.py", "_tick"),
     "  collision checks": ("adapters/fleet/collisions.py", "guard"),
-    "bus publish (all messages)": ("cosim/bus.py", "publish"),
+    "bus publish (one message)": ("cosim/bus.py", "publish"),
+    "bus publish_many (a fleet's scans, odometry, commands)": ("cosim/bus.py", "publish_many"),
 }
 
 
