@@ -46,12 +46,21 @@ class Hall(NamedTuple):
         side_m: side of the square hall (m).
         shelves: shelf count (racks of 3).
         duration_s: simulated time of the run (s).
+        placement: ``robots.placement``: ``dock`` (the preset's: every robot leaves a
+            packed dock at t = 0) or ``random`` (robots spread over the floor, as in a
+            hall at work).
     """
 
     robots: int
     side_m: float
     shelves: int
     duration_s: float
+    placement: str = "dock"
+
+    @property
+    def key(self) -> str:
+        """Its key in the results: ``robots_<N>``, with ``_<placement>`` unless the dock."""
+        return f"robots_{self.robots}" + ("" if self.placement == "dock" else f"_{self.placement}")
 
 
 HALLS = (
@@ -60,9 +69,12 @@ HALLS = (
     Hall(200, 60.0, 300, 20.0),
     Hall(500, 75.0, 360, 10.0),
     Hall(1000, 100.0, 600, 10.0),
+    Hall(1000, 100.0, 600, 10.0, "random"),
 )
 """18 m^2 of floor per robot up to 200 robots (the 30 m hall holds 50), 11.3 m^2 at 500 and
-10 m^2 at 1,000; 0.08 shelves per m^2 up to 200 robots, 0.064 at 500, 0.06 at 1,000."""
+10 m^2 at 1,000; 0.08 shelves per m^2 up to 200 robots, 0.064 at 500, 0.06 at 1,000. The
+1,000 robots run twice: from the preset's dock (where they gridlock at the start) and spread
+over the floor."""
 
 
 class WallMarks:
@@ -116,6 +128,7 @@ def _child(hall: Hall, seed: int) -> Result:
             "scenario.duration_s": hall.duration_s,
             "scenario.seed": seed,
             "robots.count": hall.robots,
+            "robots.placement": hall.placement,
             "world.size_m": [hall.side_m, hall.side_m],
             "world.shelf_count": hall.shelves,
             "record.bag": "none",
@@ -129,6 +142,7 @@ def _child(hall: Hall, seed: int) -> Result:
     robot_s = hall.robots * hall.duration_s
     out: Result = {
         "robots": hall.robots,
+        "placement": hall.placement,
         "hall_m": [hall.side_m, hall.side_m],
         "shelves": summary["shelves"],
         "sim_time_s": hall.duration_s,
@@ -197,7 +211,7 @@ def fleet_scaling(
         ),
     }
     for hall in halls:
-        key = f"robots_{hall.robots}"
+        key = hall.key
         child = json.dumps(hall._asdict())
         start = time.perf_counter()
         try:
@@ -228,6 +242,10 @@ def fleet_scaling(
         rtf_1000_target=RTF_TARGET,
         rtf_1000_met=None if rtf is None else rtf >= RTF_TARGET,
         rtf_1000_after_warmup=biggest.get("real_time_factor_after_warmup"),
+        rtf_1000_random=out.get("robots_1000_random", {}).get("real_time_factor"),
+        rtf_1000_random_after_warmup=out.get("robots_1000_random", {}).get(
+            "real_time_factor_after_warmup"
+        ),
         peak_rss_mb_1000=rss,
         peak_rss_mb_1000_target=PEAK_RSS_TARGET_MB,
         peak_rss_mb_1000_met=None if rss is None else rss <= PEAK_RSS_TARGET_MB,
