@@ -173,37 +173,25 @@ class Bus:
         Monitors see it first; remote hosts are handed to the link next (their deliveries
         are scheduled), then local subscribers are called at once, in subscription order.
         """
-        self.published += 1
-        route = self._routes.get((topic, src))
-        if route is None:
-            route = self._route(topic, src)
-        local, remote, monitors = route
-        if monitors:
-            t_ns = int(self.kernel.env.now)
-            for monitor in monitors:
-                monitor(topic, message, src, t_ns)
-        if not local and not remote:
-            return
-        now = int(self.kernel.env.now)
-        nbytes = message.size_bytes()
-        if remote:
-            self._dispatch(topic, message, src, now, nbytes, remote)
-        if local:
-            if self.tap is not None:
-                self.tap.on_transfer(now, now, src, src, topic, nbytes, DeliveryStatus.DELIVERED)
-            envelope = Envelope(topic, src, now, now)
-            for callback in local:
-                callback(message, envelope)
+        self.publish_many((topic,), (message,), (src,))
 
     def publish_many(
         self, topics: Sequence[str], messages: Sequence[Message], sources: Sequence[HostId]
     ) -> None:
         """Publish ``messages[k]`` on ``topics[k]`` from ``sources[k]``, for k in order.
 
-        Exactly ``publish`` called for each in turn (same monitors, deliveries, records and
-        order), with the per-call work done once: a fleet's odometry, scans and commands
-        are one call per tick instead of one per robot.
+        The same as :meth:`publish` for each in turn (same monitors, deliveries, records
+        and order), with the per-call work done once: a fleet's odometry, scans and
+        commands are one call per tick instead of one per robot.
+
+        Raises:
+            ValueError: when the three sequences differ in length (nothing is published).
         """
+        if not len(topics) == len(messages) == len(sources):
+            raise ValueError(
+                f"publish_many needs one topic and one source per message: got "
+                f"{len(topics)} topics, {len(messages)} messages, {len(sources)} sources"
+            )
         routes, tap = self._routes, self.tap
         now = int(self.kernel.env.now)
         delivered = DeliveryStatus.DELIVERED

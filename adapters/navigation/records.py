@@ -12,12 +12,9 @@ from typing import Any
 
 import numpy as np
 
+from adapters.navigation.recovery import STUCK_KINDS
 from cosim.records import Recorder
 from cosim.timebase import NS_PER_S
-
-STUCK_KINDS = ("halted", "detoured", "slowed")
-"""Why a robot reported ``stuck``: it hardly moved, its way grew, or it drove without
-getting nearer (summary keys ``stuck_halted``, ``stuck_detoured``, ``stuck_slowed``)."""
 
 NAV_COLUMNS = (
     "t_s",

@@ -181,6 +181,9 @@ class Recovery:
         return bool(gap.min() > self.radius_m + BACK_UP_MARGIN_M)
 
 
+STUCK_KINDS = ("halted", "detoured", "slowed")
+"""Why a robot reported ``stuck`` (:func:`stuck_kind`); the summary counts each as
+``stuck_<kind>``."""
 STUCK_HALTED_M = 1.0
 """A ``stuck`` robot that drove less than this since its last progress was halted (m)."""
 STUCK_DETOURED_M = 5.0

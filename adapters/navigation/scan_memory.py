@@ -144,5 +144,4 @@ class MovingMemory:
             return np.zeros((0, 2))
         every = np.concatenate(parts)
         every_keys = np.concatenate(keys) if cell_m == self.cell_m else cell_keys(every, cell_m)
-        whole = np.zeros(1, dtype=np.int64), np.array([len(every)])
-        return first_per_cell(every, every_keys, *whole)
+        return first_per_cell(every, every_keys)

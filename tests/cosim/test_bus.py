@@ -268,3 +268,26 @@ def test_publishing_many_at_once_is_publishing_each_in_turn():
     assert got == want_got and seen == want_seen
     assert len(got) == 5  # /x: a at once, b remote; /y: b remote (c lost); /x from c: a, b
     assert frame.equals(want_frame)
+
+
+@pytest.mark.parametrize(
+    ("topics", "messages", "sources"),
+    [
+        (["/x", "/x"], [Twist(0.0, 0.0)], [A, A]),
+        (["/x"], [Twist(0.0, 0.0)], [A, B]),
+        ([], [Twist(0.0, 0.0)], []),
+    ],
+)
+def test_publishing_many_with_unmatched_lists_is_refused_before_anything_is_sent(
+    topics, messages, sources
+):
+    kernel = Kernel()
+    recorder = Recorder()
+    bus = Bus(kernel, FixedDelayLink(0), tap=recorder)
+    got: list[Message] = []
+    bus.subscribe("/x", A, lambda m, e: got.append(m))
+    bus.subscribe("/x", B, lambda m, e: got.append(m))
+    with pytest.raises(ValueError, match=r"one topic and one source per message: got \d+ topics"):
+        bus.publish_many(topics, messages, sources)
+    kernel.run(1_000)
+    assert got == [] and bus.published == 0 and sum(recorder.counts.values()) == 0
