@@ -168,6 +168,7 @@ class NavigationAdapter:
         self.progress_ns = np.zeros(n, dtype=np.int64)
         self.progress_driven_m = np.zeros(n)  # distance driven at the last progress
         self.stuck = np.zeros(n, dtype=bool)
+        self.yardstick_from = np.zeros((n, 2))  # true position where each goal started
         self.robots_layer: RobotsLayer | None = None
         if cfg.robots_layer:
             self.robots_layer = RobotsLayer(
@@ -286,18 +287,30 @@ class NavigationAdapter:
         self.goal[i] = (goal.x_m, goal.y_m)
         self.records.row(now, i, "goal", goal.x_m, goal.y_m)
         where = goal_status(self.static, (goal.x_m, goal.y_m))
-        shortest = math.inf
-        if where is GoalStatus.OK:
-            # on the true map from the true position: the yardstick of path_length_ratio
-            truth = (float(self.fleet.x[i]), float(self.fleet.y[i]))
-            marks = None if self.landmarks is None else self.landmarks.get(0.0)
-            shortest = shortest_path_length_m(
-                self.static, truth, (goal.x_m, goal.y_m), landmarks=marks
-            )
-        if not math.isfinite(shortest):
-            detail = where.value if where is not GoalStatus.OK else "enclosed"
-            self._drop(run, i, "unreachable", detail)
+        truth = np.array([self.fleet.x[i], self.fleet.y[i]])
+        self.yardstick_from[i] = truth
+        if where is not GoalStatus.OK:
+            self._drop(run, i, "unreachable", where.value)
             return
+        # The yardstick of path_length_ratio: the shortest way on the true map from the true
+        # position, needed only once the goal is reached. A robot that plans on the static
+        # layer from exactly its true position finds a route on it (its first plan's
+        # "cleared" attempt) if and only if the yardstick exists: same costs, same start,
+        # same lethal threshold. Such a robot leaves the yardstick until it arrives (at
+        # 1,000 robots, half the A* searches at t = 0 were yardsticks of goals never reached
+        # in the run); any other robot (own map, drifting or measured pose) needs it now.
+        deferred = not self.mapping and bool(np.array_equal(self.pose[i, :2], truth))
+        shortest = math.nan if deferred else self._yardstick(i)
+        if not deferred and not math.isfinite(shortest):
+            self._drop(run, i, "unreachable", "enclosed")
+            return
+        started = time.perf_counter()
+        route, detail, points = self._route(i, now, replan=False)
+        if deferred and route is None:
+            shortest = self._yardstick(i)
+            if not math.isfinite(shortest):
+                self._drop(run, i, "unreachable", "enclosed")
+                return
         self.active[i] = True
         self.stuck[i] = False
         self.best_remaining[i] = math.inf
@@ -306,8 +319,16 @@ class NavigationAdapter:
         self.recovery.reset(i)
         self.stalls.reset(i, self.pose[i], now)
         self.records.start_goal(i, now, float(self.fleet.distance_m[i]), shortest)
-        self._status(run, i, "accepted", shortest)
-        self._plan(run, i, now, replan=False)
+        way = shortest if route is None or not deferred else route[1]
+        self._status(run, i, "accepted", way)
+        self._finish_plan(run, i, now, route, detail, points, started, replan=False)
+
+    def _yardstick(self, i: int) -> float:
+        """Robot ``i``'s shortest way (m) on the true map from where its goal started."""
+        marks = None if self.landmarks is None else self.landmarks.get(0.0)
+        return shortest_path_length_m(
+            self.static, self.yardstick_from[i], self.goal[i], landmarks=marks
+        )
 
     def _drop(self, run: RunContext, i: int, state: str, detail: str = "") -> None:
         self.active[i] = False
@@ -337,7 +358,20 @@ class NavigationAdapter:
         return points, discs
 
     def _plan(self, run: RunContext, i: int, now_ns: int, *, replan: bool) -> bool:
-        start = time.perf_counter()
+        started = time.perf_counter()
+        route, detail, points = self._route(i, now_ns, replan=replan)
+        self._finish_plan(run, i, now_ns, route, detail, points, started, replan=replan)
+        return route is not None
+
+    def _route(
+        self, i: int, now_ns: int, *, replan: bool
+    ) -> tuple[tuple[np.ndarray, float] | None, str, np.ndarray]:
+        """A new route for robot ``i``, without following it yet.
+
+        Returns:
+            ``(waypoints, length_m)`` or None, how it was found (the plan row's detail),
+            and the moving things it was planned round.
+        """
         points, discs = self._obstacles_for_plan(i, now_ns)
         layer = self.layers[i]
         # a robot mapping as it goes plans in full: the rest of its old path was planned on
@@ -350,6 +384,7 @@ class NavigationAdapter:
         # the way much longer than it was is checked against a full replan (another aisle
         # may be shorter than the detour round a jam)
         route = None
+        detail = ""
         was = float(self.paths.follow_one(i, self.pose[i, 0], self.pose[i, 1])) if repair else 0.0
         for seen, near, detail in ((points, discs, ""), (nothing, np.zeros((0, 3)), "cleared")):
             route = self._repair(i, layer, seen, near) if repair else None
@@ -361,6 +396,21 @@ class NavigationAdapter:
                 route, detail = repaired, f"{detail} repaired".strip()
             if route is not None:
                 break
+        return route, detail, points
+
+    def _finish_plan(
+        self,
+        run: RunContext,
+        i: int,
+        now_ns: int,
+        route: tuple[np.ndarray, float] | None,
+        detail: str,
+        points: np.ndarray,
+        started: float,
+        *,
+        replan: bool,
+    ) -> None:
+        """Follow a found route (or retry at the next replan) and record the plan."""
         if route is not None:
             self._set_path(run, i, now_ns, route[0], points)
         else:
@@ -372,10 +422,9 @@ class NavigationAdapter:
             self.goal[i, 0],
             self.goal[i, 1],
             path_length_m=route[1] if route is not None else math.nan,
-            plan_ms=(time.perf_counter() - start) * 1e3,
+            plan_ms=(time.perf_counter() - started) * 1e3,
             detail=detail if route is not None else "no path",
         )
-        return route is not None
 
     def _repair(
         self, i: int, layer: StaticCostmap, points: np.ndarray, discs: np.ndarray
@@ -526,6 +575,8 @@ class NavigationAdapter:
         for i in np.flatnonzero(self.active & (gap <= self.cfg.goal_tolerance_m)).tolist():
             self.active[i] = False
             self.paths.clear(i)
+            if math.isnan(self.records.shortest_m[i]):
+                self.records.shortest_m[i] = self._yardstick(i)
             self.records.arrived(
                 now_ns, i, self.goal[i, 0], self.goal[i, 1], float(self.fleet.distance_m[i])
             )

@@ -16,6 +16,8 @@ from cosim.registry import AdapterRegistry
 from cosim.runner import execute
 from cosim.timebase import s_to_ns
 from models.kinematics import FleetState
+from models.navigation.costmap import StaticCostmap
+from models.navigation.planner import shortest_path_length_m
 from models.obstacles import DynamicObstacles
 
 
@@ -26,12 +28,14 @@ class GoalScript:
     requires: ClassVar[tuple[str, ...]] = ("navigation",)
     goals: ClassVar[list[tuple[float, str, float, float]]] = []
     statuses: ClassVar[list[tuple[float, str, str, int]]] = []
+    static: ClassVar[StaticCostmap | None] = None
 
     def __init__(self, run: RunContext) -> None:
         GoalScript.statuses = []
         self.names = run.service(FleetState).names
 
     def start(self, run: RunContext) -> None:
+        GoalScript.static = run.service(StaticCostmap)
         for name in self.names:
 
             def keep(message: Message, envelope: Any, name: str = name) -> None:
@@ -117,6 +121,18 @@ def test_a_robot_drives_around_a_box_to_its_goal():
     assert result.summary["collisions"] == 0
     assert result.summary["arrivals"] == 1
     assert 1.0 <= result.summary["path_length_ratio"] < 1.3
+
+
+def test_the_path_length_ratio_measures_against_the_shortest_way_from_where_each_goal_started():
+    # the robot stands exactly where it is at t = 0: its yardstick waits for the arrival,
+    # and is the shortest way from where the goal started, not from where it ended
+    result = _run(ROOM, [(0.0, "robot_1", 10.5, 4.0)], duration_s=20.0)
+    navigation = result.tables["navigation"]
+    driven = float(navigation.query("event == 'arrived'")["path_length_m"].iloc[0])
+    assert GoalScript.static is not None
+    shortest = shortest_path_length_m(GoalScript.static, (1.5, 4.0), (10.5, 4.0))
+    assert result.summary["path_length_ratio"] == pytest.approx(driven / shortest, rel=1e-6)
+    assert 1.0 <= driven / shortest < 1.3
 
 
 @pytest.mark.parametrize(
