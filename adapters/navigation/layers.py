@@ -20,6 +20,17 @@ from models.navigation.lanes import TWO_WAY, aisle_lanes
 from models.occupancy import FREE, OCCUPIED, UNKNOWN, OccupancyGrid, resample
 
 
+class StaticLayer:
+    """The static map navigation plans on; a later mapping adapter may provide its own.
+
+    Attributes:
+        grid: the occupancy grid (``map`` frame).
+    """
+
+    def __init__(self, grid: OccupancyGrid) -> None:
+        self.grid = grid
+
+
 class StaticLayers:
     """Each robot's static costmap and their distance grids.
 

@@ -28,7 +28,7 @@ import numpy as np
 from adapters.fleet.motion import drive_limits
 from adapters.mapping.geometry import map_geometry, unknown_grid
 from adapters.naming import topic
-from adapters.navigation.layers import StaticLayers, lanes_on
+from adapters.navigation.layers import StaticLayer, StaticLayers, lanes_on
 from adapters.navigation.localization import MeasuredPoses
 from adapters.navigation.records import NavRecords
 from adapters.navigation.recovery import Recovery, StallWatch, stuck_kind
@@ -58,7 +58,7 @@ from models.navigation.costmap import CostmapParams, StaticCostmap, with_obstacl
 from models.navigation.dwa import DwaParams, dwa_batch
 from models.navigation.follow import PathBook, paths_blocked
 from models.navigation.landmarks import ALT_MIN_CELLS, LandmarkCache
-from models.navigation.lanes import TWO_WAY
+from models.navigation.lanes import in_lanes
 from models.navigation.planner import (
     GoalStatus,
     goal_status,
@@ -69,7 +69,7 @@ from models.navigation.planner import (
 )
 from models.navigation.repair import RepairParams, repair_path
 from models.navigation.traffic import TrafficParams, keep_right, moving_points, speed_caps
-from models.occupancy import OccupancyGrid, ground_truth_grid
+from models.occupancy import ground_truth_grid
 from models.world import Warehouse
 
 PROGRESS_M = 0.2
@@ -86,17 +86,9 @@ LANE_AGAINST = 5.0
 """``traffic = "lanes"``: a step against an aisle's direction costs this many times more."""
 HALT_RADPS = 0.05
 """...when it does not turn faster than this either (rad/s)."""
-
-
-class StaticLayer:
-    """The static map navigation plans on; a later mapping adapter may provide its own.
-
-    Attributes:
-        grid: the occupancy grid (``map`` frame).
-    """
-
-    def __init__(self, grid: OccupancyGrid) -> None:
-        self.grid = grid
+Found = tuple[tuple[np.ndarray, float] | None, str, np.ndarray]
+"""A plan's outcome: the route ``(waypoints, length_m)`` or None, how it was found, and the
+moving things planned round."""
 
 
 class NavigationAdapter:
@@ -292,20 +284,19 @@ class NavigationAdapter:
         if where is not GoalStatus.OK:
             self._drop(run, i, "unreachable", where.value)
             return
-        # The yardstick of path_length_ratio: the shortest way on the true map from the true
-        # position, needed only once the goal is reached. A robot that plans on the static
-        # layer from exactly its true position finds a route on it (its first plan's
-        # "cleared" attempt) if and only if the yardstick exists: same costs, same start,
-        # same lethal threshold. Such a robot leaves the yardstick until it arrives (at
-        # 1,000 robots, half the A* searches at t = 0 were yardsticks of goals never reached
-        # in the run); any other robot (own map, drifting or measured pose) needs it now.
+        # path_length_ratio's yardstick (shortest way on the true map from the true position)
+        # counts only on arrival. A robot planning on the static layer from exactly its true
+        # position finds a route there (its first plan's "cleared" try) if and only if the
+        # yardstick exists, so it measures it on arrival (1,000 robots: half the searches
+        # at t = 0 were yardsticks of goals not reached in the run); others need it now.
         deferred = not self.mapping and bool(np.array_equal(self.pose[i, :2], truth))
         shortest = math.nan if deferred else self._yardstick(i)
         if not deferred and not math.isfinite(shortest):
             self._drop(run, i, "unreachable", "enclosed")
             return
         started = time.perf_counter()
-        route, detail, points = self._route(i, now, replan=False)
+        found = self._route(i, now, replan=False)
+        route = found[0]
         if deferred and route is None:
             shortest = self._yardstick(i)
             if not math.isfinite(shortest):
@@ -321,7 +312,7 @@ class NavigationAdapter:
         self.records.start_goal(i, now, float(self.fleet.distance_m[i]), shortest)
         way = shortest if route is None or not deferred else route[1]
         self._status(run, i, "accepted", way)
-        self._finish_plan(run, i, now, route, detail, points, started, replan=False)
+        self._finish_plan(run, i, now, found, started, replan=False)
 
     def _yardstick(self, i: int) -> float:
         """Robot ``i``'s shortest way (m) on the true map from where its goal started."""
@@ -345,33 +336,19 @@ class NavigationAdapter:
         if self.lanes is not None and len(points):
             # in a one-way aisle whatever moves goes the robot's way: it is traffic to
             # follow (the local controller keeps the distance), not a wall to plan round
-            origin = np.asarray(self.layers.origin_xy_m)
-            cells = np.floor((points - origin) / res).astype(np.int64)
-            rows, cols = self.lanes.shape
-            inside = (cells[:, 0] >= 0) & (cells[:, 0] < cols) & (cells[:, 1] >= 0)
-            inside &= cells[:, 1] < rows
-            in_lane = np.zeros(len(points), dtype=bool)
-            in_lane[inside] = self.lanes[cells[inside, 1], cells[inside, 0]] != TWO_WAY
-            points = points[~in_lane]
+            points = points[~in_lanes(self.lanes, points, self.layers.origin_xy_m, res)]
         no_discs = np.zeros((0, 3))
         discs = no_discs if self.robots_layer is None else self.robots_layer.discs(i, now_ns)
         return points, discs
 
     def _plan(self, run: RunContext, i: int, now_ns: int, *, replan: bool) -> bool:
         started = time.perf_counter()
-        route, detail, points = self._route(i, now_ns, replan=replan)
-        self._finish_plan(run, i, now_ns, route, detail, points, started, replan=replan)
-        return route is not None
+        found = self._route(i, now_ns, replan=replan)
+        self._finish_plan(run, i, now_ns, found, started, replan=replan)
+        return found[0] is not None
 
-    def _route(
-        self, i: int, now_ns: int, *, replan: bool
-    ) -> tuple[tuple[np.ndarray, float] | None, str, np.ndarray]:
-        """A new route for robot ``i``, without following it yet.
-
-        Returns:
-            ``(waypoints, length_m)`` or None, how it was found (the plan row's detail),
-            and the moving things it was planned round.
-        """
+    def _route(self, i: int, now_ns: int, *, replan: bool) -> Found:
+        """A new route for robot ``i`` (:data:`Found`), not followed yet."""
         points, discs = self._obstacles_for_plan(i, now_ns)
         layer = self.layers[i]
         # a robot mapping as it goes plans in full: the rest of its old path was planned on
@@ -399,18 +376,10 @@ class NavigationAdapter:
         return route, detail, points
 
     def _finish_plan(
-        self,
-        run: RunContext,
-        i: int,
-        now_ns: int,
-        route: tuple[np.ndarray, float] | None,
-        detail: str,
-        points: np.ndarray,
-        started: float,
-        *,
-        replan: bool,
+        self, run: RunContext, i: int, now_ns: int, found: Found, started: float, *, replan: bool
     ) -> None:
         """Follow a found route (or retry at the next replan) and record the plan."""
+        route, detail, points = found
         if route is not None:
             self._set_path(run, i, now_ns, route[0], points)
         else:

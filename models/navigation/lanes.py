@@ -91,4 +91,29 @@ def aisle_lanes(obstacle: BoolArray, resolution_m: float, max_width_m: float) ->
     return lanes
 
 
-__all__ = ["EAST", "NORTH", "SOUTH", "TWO_WAY", "WEST", "aisle_lanes"]
+def in_lanes(
+    lanes: UInt8Array,
+    points: npt.NDArray[np.float64],
+    origin_xy_m: tuple[float, float],
+    cell_m: float,
+) -> npt.NDArray[np.bool_]:
+    """Which (x, y) points (m, the grid's frame) lie in a one-way cell of ``lanes``.
+
+    Args:
+        lanes: (rows, cols) lane directions (``TWO_WAY`` where none).
+        points: (k, 2) points (m).
+        origin_xy_m: the grid's lower-left corner (m).
+        cell_m: cell size (m).
+
+    Returns:
+        (k,) True where the point's cell is one-way; points off the grid are not.
+    """
+    cells = np.floor((points - np.asarray(origin_xy_m)) / cell_m).astype(np.int64)
+    rows, cols = lanes.shape
+    inside = (cells[:, 0] >= 0) & (cells[:, 0] < cols) & (cells[:, 1] >= 0) & (cells[:, 1] < rows)
+    out = np.zeros(len(points), dtype=bool)
+    out[inside] = lanes[cells[inside, 1], cells[inside, 0]] != TWO_WAY
+    return out
+
+
+__all__ = ["EAST", "NORTH", "SOUTH", "TWO_WAY", "WEST", "aisle_lanes", "in_lanes"]
