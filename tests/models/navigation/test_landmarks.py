@@ -4,7 +4,6 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from models.errors import ModelError
@@ -24,11 +23,10 @@ from models.navigation.landmarks import (
 from models.navigation.planner import plan, shortest_path_length_m
 from models.occupancy import OCCUPIED, OccupancyGrid, ground_truth_grid
 from models.world import WarehouseSpec, generate_warehouse
+from tests.models.navigation.grid_graph import planner_graph
 
 RES = 0.1
 PARAMS = CostmapParams(robot_radius_m=0.2, inflation_radius_m=0.6)
-MOVES = [(1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (1, -1), (-1, 1), (-1, -1)]
-AGAINST_LANE = {1: (-1, 0), 2: (1, 0), 3: (0, -1), 4: (0, 1)}  # lane: the sign it refuses
 
 
 def _random_static(seed: int, width: int, height: int, density: float) -> StaticCostmap:
@@ -40,30 +38,6 @@ def _random_static(seed: int, width: int, height: int, density: float) -> Static
     data[0, :] = data[-1, :] = data[:, 0] = data[:, -1] = OCCUPIED
     grid = OccupancyGrid(resolution_m=RES, origin_xy_m=(0.0, 0.0), data=data)
     return StaticCostmap.from_grid(grid, PARAMS)
-
-
-def _graph(cost, weight, lanes=None, against=1.0, lethal=INSCRIBED):
-    """The planner's directed 8-connected graph (scipy CSR), edge costs in cells."""
-    h, w = cost.shape
-    src, dst, wt = [], [], []
-    for y in range(h):
-        for x in range(w):
-            for dx, dy in MOVES:
-                nx, ny = x + dx, y + dy
-                if not (0 <= nx < w and 0 <= ny < h) or cost[ny, nx] >= lethal:
-                    continue
-                if dx and dy and (cost[y, nx] >= lethal or cost[ny, x] >= lethal):
-                    continue
-                step = math.sqrt(2.0) if dx and dy else 1.0
-                step *= 1.0 + weight * cost[ny, nx] / 252.0
-                if lanes is not None and lanes[ny, nx] in AGAINST_LANE:
-                    sx, sy = AGAINST_LANE[int(lanes[ny, nx])]
-                    if (sx and np.sign(dx) == sx) or (sy and np.sign(dy) == sy):
-                        step *= against
-                src.append(y * w + x)
-                dst.append(ny * w + nx)
-                wt.append(step)
-    return coo_matrix((wt, (src, dst)), shape=(h * w, h * w)).tocsr()
 
 
 def _bounds_to(landmarks: Landmarks, goal: tuple[int, int]) -> np.ndarray:
@@ -104,7 +78,7 @@ def test_alt_a_star_finds_the_least_cost_that_plain_a_star_and_dijkstra_find(roo
         return
     marks = build_landmarks(static.cost, count=4, cost_weight=weight)
     rng = np.random.default_rng(room[0])
-    graph = _graph(static.cost, weight)
+    graph = planner_graph(static.cost, weight)
     width = static.width
     for _ in range(3):
         start, goal = _free_pair(rng, static.cost)
@@ -139,7 +113,7 @@ def test_alt_a_star_stays_exact_with_obstacles_stamped_and_lanes_laid_after_the_
     robots = np.column_stack([rng.random((discs, 2)) * size, np.full(discs, 0.25)])
     cost = with_obstacles(static, seen, discs=robots)
     lanes = rng.integers(0, 5, size=cost.shape).astype(np.uint8) if lanes_on else None
-    graph = _graph(cost, 1.0, lanes, against)
+    graph = planner_graph(cost, 1.0, lanes, against)
     for _ in range(3 if (cost < INSCRIBED).any() else 0):
         start, goal = _free_pair(rng, cost)  # enterable despite the stamps
         alt = plan(cost, start, goal, landmarks=marks, lanes=lanes, against=against)
@@ -161,7 +135,7 @@ def test_the_heuristic_never_exceeds_the_cost_to_go_and_is_consistent(room, weig
     marks = build_landmarks(static.cost, count=6, cost_weight=weight)
     rng = np.random.default_rng(room[0] + 2)
     _, goal = _free_pair(rng, static.cost)
-    graph = _graph(static.cost, weight)
+    graph = planner_graph(static.cost, weight)
     width = static.width
     to_goal = dijkstra(graph.T.tocsr(), indices=goal[1] * width + goal[0])  # cost-to-go
     h = _bounds_to(marks, goal)

@@ -3,7 +3,6 @@ import math
 
 import numpy as np
 import pytest
-from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from models.errors import ModelError
@@ -25,10 +24,10 @@ from models.navigation.planner import (
 )
 from models.occupancy import OCCUPIED, OccupancyGrid, ground_truth_grid
 from models.world import WarehouseSpec, generate_warehouse
+from tests.models.navigation.grid_graph import planner_graph
 
 RES = 0.1
 PARAMS = CostmapParams(robot_radius_m=0.2, inflation_radius_m=0.6)
-MOVES = [(1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (1, -1), (-1, 1), (-1, -1)]
 
 
 def _static(rows, res=RES, params=PARAMS):
@@ -50,21 +49,8 @@ def _box_room(width, height, boxes=()):
 
 def _reference_cost(cost, start, goal, weight, lethal=INSCRIBED):
     """Dijkstra (scipy) on the same directed 8-connected graph: cost in cells or inf."""
-    h, w = cost.shape
-    src, dst, wt = [], [], []
-    for y in range(h):
-        for x in range(w):
-            for dx, dy in MOVES:
-                nx, ny = x + dx, y + dy
-                if not (0 <= nx < w and 0 <= ny < h) or cost[ny, nx] >= lethal:
-                    continue
-                if dx and dy and (cost[y, nx] >= lethal or cost[ny, x] >= lethal):
-                    continue
-                step = math.sqrt(2.0) if dx and dy else 1.0
-                src.append(y * w + x)
-                dst.append(ny * w + nx)
-                wt.append(step * (1.0 + weight * cost[ny, nx] / 252.0))
-    graph = coo_matrix((wt, (src, dst)), shape=(h * w, h * w)).tocsr()
+    w = cost.shape[1]
+    graph = planner_graph(cost, weight, lethal=lethal)
     dist = dijkstra(graph, directed=True, indices=start[1] * w + start[0])
     return dist[goal[1] * w + goal[0]]
 
