@@ -28,6 +28,7 @@ import numpy as np
 from adapters.fleet.motion import drive_limits
 from adapters.mapping.geometry import map_geometry, unknown_grid
 from adapters.naming import topic
+from adapters.navigation.fleet_traffic import FleetTraffic
 from adapters.navigation.layers import StaticLayer, StaticLayers, lanes_on
 from adapters.navigation.localization import MeasuredPoses
 from adapters.navigation.records import NavRecords
@@ -81,7 +82,8 @@ HALT_MPS = 0.02
 REPAIR_DETOUR_M = 2.0
 """A repair lengthening the way by more than this is checked against a full replan (m)."""
 LANE_WIDTH_M = 2.5
-"""``traffic = "lanes"``: aisles up to this wide are one-way (m); two robots pass in wider."""
+"""``traffic = "lanes"`` and ``"pibt"``: aisles up to this wide are one-way (m); two robots
+pass in wider."""
 LANE_AGAINST = 5.0
 """``traffic = "lanes"``: a step against an aisle's direction costs this many times more."""
 HALT_RADPS = 0.05
@@ -130,6 +132,15 @@ class NavigationAdapter:
                 ground_truth_grid(run.service(Warehouse), cfg.resolution_m),
                 LANE_WIDTH_M,
             )
+        self.places: FleetTraffic | None = None
+        if cfg.traffic == "pibt":  # the fleet manager moves every robot place by place
+            truth = ground_truth_grid(run.service(Warehouse), cfg.resolution_m)
+            self.places = FleetTraffic(
+                self.static,
+                lanes_on(self.static, truth, LANE_WIDTH_M),
+                np.stack([self.fleet.x, self.fleet.y], axis=1),
+                radius,
+            )
         run.provide(self.static)
         # A*'s landmark bounds on the shared static layer, built on first use, on floors
         # large enough for the fleet's plans to pay for them (see _full for where they hold)
@@ -160,6 +171,7 @@ class NavigationAdapter:
         self.progress_ns = np.zeros(n, dtype=np.int64)
         self.progress_driven_m = np.zeros(n)  # distance driven at the last progress
         self.stuck = np.zeros(n, dtype=bool)
+        self.remaining = np.zeros(n)  # way left to each goal at the last control tick (m)
         self.yardstick_from = np.zeros((n, 2))  # true position where each goal started
         self.robots_layer: RobotsLayer | None = None
         if cfg.robots_layer:
@@ -273,6 +285,8 @@ class NavigationAdapter:
             self.paths.clear(i)
             if was_active:
                 self.records.row(now, i, "cancelled", self.goal[i, 0], self.goal[i, 1])
+            if self.places is not None:
+                self.places.end_goal(i)
             self._status(run, i, "cancelled", math.nan)
             return
         self.goal_id[i] = goal.goal_id
@@ -289,10 +303,19 @@ class NavigationAdapter:
         # position finds a route there (its first plan's "cleared" try) if and only if the
         # yardstick exists, so it measures it on arrival (1,000 robots: half the searches
         # at t = 0 were yardsticks of goals not reached in the run); others need it now.
-        deferred = not self.mapping and bool(np.array_equal(self.pose[i, :2], truth))
+        places = self.places
+        deferred = places is None and not self.mapping and np.array_equal(self.pose[i, :2], truth)
         shortest = math.nan if deferred else self._yardstick(i)
         if not deferred and not math.isfinite(shortest):
             self._drop(run, i, "unreachable", "enclosed")
+            return
+        if places is not None:
+            place = places.goal_place(i, self.goal[i])
+            if place < 0:
+                self._drop(run, i, "unreachable", "off the fleet's places")
+                return
+            self._begin(run, i, now, shortest, shortest)
+            places.set_goal(i, self.goal[i], place, now)
             return
         started = time.perf_counter()
         found = self._route(i, now, replan=False)
@@ -302,6 +325,11 @@ class NavigationAdapter:
             if not math.isfinite(shortest):
                 self._drop(run, i, "unreachable", "enclosed")
                 return
+        self._begin(run, i, now, shortest, shortest if route is None or not deferred else route[1])
+        self._finish_plan(run, i, now, found, started, replan=False)
+
+    def _begin(self, run: RunContext, i: int, now: int, shortest: float, way: float) -> None:
+        """Robot ``i`` drives to its goal from now; ``way`` (m) goes out as accepted."""
         self.active[i] = True
         self.stuck[i] = False
         self.best_remaining[i] = math.inf
@@ -310,9 +338,7 @@ class NavigationAdapter:
         self.recovery.reset(i)
         self.stalls.reset(i, self.pose[i], now)
         self.records.start_goal(i, now, float(self.fleet.distance_m[i]), shortest)
-        way = shortest if route is None or not deferred else route[1]
         self._status(run, i, "accepted", way)
-        self._finish_plan(run, i, now, found, started, replan=False)
 
     def _yardstick(self, i: int) -> float:
         """Robot ``i``'s shortest way (m) on the true map from where its goal started."""
@@ -324,6 +350,8 @@ class NavigationAdapter:
     def _drop(self, run: RunContext, i: int, state: str, detail: str = "") -> None:
         self.active[i] = False
         self.paths.clear(i)
+        if self.places is not None:
+            self.places.end_goal(i)
         self.records.row(
             run.kernel.now_ns, i, state, self.goal[i, 0], self.goal[i, 1], detail=detail
         )
@@ -477,7 +505,7 @@ class NavigationAdapter:
             self.traffic,
         )
         self.moving.remember(now_ns, moving.owner, moving.points)
-        due = self.active & (now_ns >= self.next_plan_ns)
+        due = self.active & (now_ns >= self.next_plan_ns) & (self.places is None)
         if due.any():
             # periodic replans only when the costmap changed where it matters: something
             # moving on the path ahead now, or around the last plan (Nav2 replans at 1 Hz
@@ -490,10 +518,15 @@ class NavigationAdapter:
                     self._plan(run, i, now_ns, replan=True)
                 else:
                     self.next_plan_ns[i] = now_ns + period_ns(self.cfg.replan_hz)
-        carrots, remaining = self.paths.follow(
-            self.pose[:, 0], self.pose[:, 1], self.cfg.lookahead_m
-        )
-        carrots = keep_right(carrots, moving, self.pose, self.active, self.traffic)
+        goals = self.goal
+        if self.places is None:
+            carrots, remaining = self.paths.follow(
+                self.pose[:, 0], self.pose[:, 1], self.cfg.lookahead_m
+            )
+            carrots = keep_right(carrots, moving, self.pose, self.active, self.traffic)
+        else:  # the point each robot drives to now (robots settling slow onto it)
+            carrots, remaining = self.places.step(self.pose, self.active, self.progress_ns, now_ns)
+            goals = carrots
         if self.robots_layer is None:
             discs, disc_start = np.zeros((0, 3)), np.zeros(len(self.names) + 1, dtype=np.int64)
         else:
@@ -504,7 +537,7 @@ class NavigationAdapter:
             self.limits,
             self.fleet.radius_m,
             carrots,
-            self.goal,
+            goals,
             points,
             start,
             discs,
@@ -514,12 +547,19 @@ class NavigationAdapter:
         caps = speed_caps(
             moving, len(self.names), self.radius, self.limits.max_speed_mps, self.traffic
         )
-        v = np.minimum(result.v, caps)
+        v, w = np.minimum(result.v, caps), result.w
         # a robot without a recent pose does not know where it is: it stops
         moving_ok = self.active & ~self.measured.check(now_ns)
+        if self.places is not None:  # every robot drives: to make way, or onto its place
+            moving_ok = ~self.measured.check(now_ns)
+            v, w = self.places.commands(self.pose, carrots, v, w, moving, self.limits)
         v = np.where(moving_ok, v, 0.0)
-        w = np.where(moving_ok, result.w, 0.0)
+        w = np.where(moving_ok, w, 0.0)
         self._track_progress(run, now_ns, remaining)
+        self.remaining = remaining
+        if self.places is not None:  # robots wait for their places: no recovery moves
+            self._publish(run, v, w)
+            return
         # halted: the controller found nothing admissible ahead, or chose to stand still
         # (a robot in the way) while its goal is elsewhere
         halted = result.blocked | ((np.abs(v) < HALT_MPS) & (np.abs(result.w) < HALT_RADPS))
@@ -536,6 +576,9 @@ class NavigationAdapter:
                 now_ns, i, "recovery", self.goal[i, 0], self.goal[i, 1], detail=kind
             ),
         )
+        self._publish(run, v, w)
+
+    def _publish(self, run: RunContext, v: np.ndarray, w: np.ndarray) -> None:
         commands = [Twist(vi, wi) for vi, wi in zip(v.tolist(), w.tolist(), strict=True)]
         run.bus.publish_many(self.cmd_topics, commands, self.hosts)
 
@@ -549,6 +592,8 @@ class NavigationAdapter:
             self.records.arrived(
                 now_ns, i, self.goal[i, 0], self.goal[i, 1], float(self.fleet.distance_m[i])
             )
+            if self.places is not None:
+                self.places.end_goal(i)
             self._status(run, i, "arrived", 0.0)
 
     def _track_progress(self, run: RunContext, now_ns: int, remaining: np.ndarray) -> None:
@@ -578,7 +623,10 @@ class NavigationAdapter:
             self._status(run, i, "stuck", float(remaining[i]))
 
     def _progress(self, run: RunContext, now_ns: int) -> None:
-        _, remaining = self.paths.follow(self.pose[:, 0], self.pose[:, 1], self.cfg.lookahead_m)
+        if self.places is None:
+            _, remaining = self.paths.follow(self.pose[:, 0], self.pose[:, 1], self.cfg.lookahead_m)
+        else:
+            remaining = self.remaining
         for i in np.flatnonzero(self.active).tolist():
             self._status(run, i, "progress", float(remaining[i]))
 

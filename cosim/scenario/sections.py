@@ -198,11 +198,13 @@ class NavigationConfig:
         gt=0,
     )
     progress_hz: float = param(1.0, "rate of `progress` status reports (Hz)", gt=0, le=1000)
-    traffic: Literal["none", "lanes"] = param(
+    traffic: Literal["none", "lanes", "pibt"] = param(
         "none",
-        "fleet traffic policy: 'lanes' makes aisles up to 2.5 m wide one-way, neighbours "
-        "in opposite directions (the planner charges 5x for a step against one); 'none': "
-        "every robot plans for itself",
+        "fleet traffic policy: 'none': every robot plans for itself (A* + DWA); 'lanes': "
+        "the same with aisles up to 2.5 m wide one-way, neighbours in opposite directions "
+        "(the planner charges 5x for a step against one); 'pibt': the fleet manager moves "
+        "every robot over a 2r + 0.14 m grid of places with those one-way aisles, one PIBT "
+        "step at a time (Okumura et al. 2022), robots stalled 10 s first, then the oldest goal",
     )
     goals: tuple[tuple[float, float], ...] = param(
         (),

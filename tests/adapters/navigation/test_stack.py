@@ -274,7 +274,7 @@ def test_with_one_way_lanes_robots_reach_goals_without_collision_and_repair_thei
 
 
 def test_an_unknown_traffic_policy_is_refused_naming_the_key_and_the_choices():
-    expected = r"\[navigation\] traffic = 'roundabouts': expected one of 'none', 'lanes'"
+    expected = r"\[navigation\] traffic = 'roundabouts': expected one of 'none', 'lanes', 'pibt'"
     with pytest.raises(cosim.ConfigError, match=expected):
         cosim.load_scenario("fleet50", {"navigation.traffic": "roundabouts"})
 

@@ -1,0 +1,358 @@
+"""``navigation.traffic = "pibt"``: a fleet manager that moves robots place by place.
+
+The fleet manager lays a grid of robot-sized places over the building's map
+(:mod:`models.navigation.roadmap`), with the narrow aisles one-way as with
+``traffic = "lanes"``, and lets each robot hold the place it stands on. At every control
+tick the robots standing on a place take one PIBT step (:mod:`models.navigation.pibt`):
+each in priority order claims the neighbouring place nearest its goal that no one holds
+or has claimed, asking a robot standing there to make way. A robot drives to its claimed
+place (:mod:`models.navigation.place_drive`: turn on the spot, then straight) and holds
+the place it left until its body is :data:`RELEASE_M` away from it; a robot that follows
+waits on its own place until then. Within :data:`ARRIVE_M` of its new place it takes its
+next step, so a robot going straight on does not stop. On its goal's place it claims
+every place its body will touch at the goal and drives there; after the goal it settles
+back on the place.
+
+Priorities: PIBT's rule (Okumura et al. 2022) is the goal's age, which always lets the
+robot waiting longest move nearer; here a robot that has made no progress for
+:data:`URGENT_S` goes before every other, the longest-stalled first, so that robots
+pushed about in a crowd get their turn before ``stuck`` (30 s) gives their goal up.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+
+from cosim.timebase import s_to_ns
+from models.arrays import BoolArray, FloatArray, IntArray, UInt8Array
+from models.errors import ModelError
+from models.kinematics import DriveLimits
+from models.navigation.costmap import StaticCostmap
+from models.navigation.pibt import Pibt
+from models.navigation.place_drive import place_drive
+from models.navigation.roadmap import (
+    UNREACHABLE,
+    Int32Array,
+    Roadmap,
+    build_roadmap,
+    one_way,
+)
+from models.navigation.traffic import MovingPoints
+
+GAP_M = 0.14
+"""Gap between two robots standing on neighbouring places (m): spacing is 2 r + gap (0.8 m
+for Jackals, a third of the 2.4 m pitch of the paper's rows of racks)."""
+CLEARANCE_M = 0.1
+"""Margin between a place, or the straight way between two, and a static obstacle (m)."""
+ARRIVE_M = 0.45
+"""A robot this close to the place it drives to stands on it and takes its next step (m)."""
+RELEASE_M = 0.5
+"""A robot lets go of the place it left once this far from its centre (m); a robot
+driving in stops for it (:func:`~models.navigation.place_drive.place_drive`) if it is
+slow to leave. Goals given up in fleet50, seeds 1-4 x 300 s: 0.4 m 45, 0.5 m 4, 0.55 m 13,
+0.6 m 25; 0.73 m (its body clear of a robot standing there; with ``ARRIVE_M`` 0.3) 11, with
+7 % fewer arrivals."""
+URGENT_S = 10.0
+"""A robot with no progress for this long goes first (s). Goals given up as above (with
+``RELEASE_M`` 0.73, ``ARRIVE_M`` 0.3): 3 s 22, 6 s 14, 10 s 11, 20 s 41; the goal's age
+alone (PIBT's rule) 32; the time since progress alone 23."""
+GOAL_REACH = 2.0
+"""A goal is reached from a place at most this many spacings away."""
+VIA_M = 0.03
+"""A robot this close to the centre of the place it turns on has passed it (m)."""
+STAND, MOVE, APPROACH, SETTLE = 0, 1, 2, 3
+"""What a robot does: stands on its place, drives to its next place, drives from its
+goal's place to the goal, drives back onto its place (after the goal, or at the start)."""
+
+
+class FleetTraffic:
+    """Places, holds and PIBT steps for the whole fleet.
+
+    Args:
+        static: the building's static costmap.
+        lanes: one-way lanes on the static costmap's cells
+            (:func:`models.navigation.lanes.aisle_lanes`).
+        poses: (n, 2) start positions (m) in ``map``.
+        radius_m: robot footprint radius (m).
+
+    Raises:
+        ModelError: when the floor has fewer places than robots.
+    """
+
+    def __init__(
+        self, static: StaticCostmap, lanes: UInt8Array, poses: FloatArray, radius_m: float
+    ) -> None:
+        self.radius_m = radius_m
+        self.static = static
+        self.spacing_m = 2 * radius_m + GAP_M
+        self.reach_m = 2 * radius_m + GAP_M / 2  # places a robot at a point touches
+        self.roadmap: Roadmap = build_roadmap(
+            static.distance_m,
+            static.origin_xy_m,
+            static.resolution_m,
+            self.spacing_m,
+            radius_m + CLEARANCE_M,
+        )
+        self.roadmap = one_way(self.roadmap, lanes, static.origin_xy_m, static.resolution_m)
+        n = len(poses)
+        self.node = self._start_places(poses)
+        self.mode = np.full(n, SETTLE, dtype=np.int64)
+        self.held: list[list[int]] = [self._touched(poses[i], int(self.node[i])) for i in range(n)]
+        self.aim = self.roadmap.xy[self.node].copy()
+        self.came_from = self.node.copy()  # the place a robot standing on its place came from
+        self.via = np.full((n, 2), np.nan)  # a place's centre to pass before turning off
+        self.goal = np.full((n, 2), np.nan)
+        self.goal_node = np.full(n, -1, dtype=np.int64)
+        self.since_ns = np.zeros(n, dtype=np.int64)
+        self.hops: dict[int, Int32Array] = {}
+
+    def _start_places(self, xy: FloatArray) -> IntArray:
+        """A distinct place for every robot, nearest overall.
+
+        A Hungarian assignment among the places near the robots.
+        """
+        rm = self.roadmap
+        if len(xy) > len(rm):
+            raise ModelError(
+                "robots.count", len(xy), f"at most {len(rm)} robots: the places of traffic 'pibt'"
+            )
+        near = np.unique(rm.nearest_k(xy, min(len(rm), 9)))
+        d = np.hypot(*(xy[:, None, :] - rm.xy[near][None, :, :]).transpose(2, 0, 1))
+        _, cols = linear_sum_assignment(d)
+        places: IntArray = near[cols].astype(np.int64)
+        return places
+
+    def _touched(self, point: FloatArray, node: int) -> list[int]:
+        """``node`` and every place a robot driving from it to ``point`` comes too close to."""
+        start = self.roadmap.xy[node]
+        steps = max(2, int(np.ceil(np.hypot(*(point - start)) / 0.1)) + 1)
+        found: list[int] = [node]
+        for t in np.linspace(0.0, 1.0, steps):
+            for u in self.roadmap.near(start + t * (point - start), self.reach_m):
+                if u not in found:
+                    found.append(u)
+        return found
+
+    def _hops(self, goal: int) -> Int32Array:
+        """Hops from every place to place ``goal`` (cached per goal place)."""
+        found = self.hops.get(goal)
+        if found is None:
+            found = self.roadmap.hops_to(goal)
+            self.hops[goal] = found
+        return found
+
+    # -- goals --------------------------------------------------------------------------
+    def goal_place(self, i: int, goal: FloatArray) -> int:
+        """The place robot ``i`` reaches ``goal`` from, or -1 if none.
+
+        The nearest of robot ``i``'s places within :data:`GOAL_REACH` spacings of the goal
+        from which the straight way to the goal keeps the footprint off static obstacles.
+        """
+        rm = self.roadmap
+        mine = np.flatnonzero(rm.component == rm.component[self.node[i]])
+        d = np.hypot(*(rm.xy[mine] - goal).T)
+        for u in mine[np.argsort(d)][: int(np.sum(d <= GOAL_REACH * rm.spacing_m))]:
+            if self._clear(rm.xy[u], goal):
+                return int(u)
+        return -1
+
+    def _clear(self, a: FloatArray, b: FloatArray) -> bool:
+        """Whether a robot driving straight from ``a`` to ``b`` keeps off static obstacles."""
+        static = self.static
+        steps = max(2, int(np.ceil(np.hypot(*(b - a)) / static.resolution_m)) + 1)
+        points = a + np.linspace(0.0, 1.0, steps)[:, None] * (b - a)
+        cells = np.floor((points - static.origin_xy_m) / static.resolution_m).astype(np.int64)
+        rows, cols = static.distance_m.shape
+        inside = (cells[:, 0] >= 0) & (cells[:, 0] < cols) & (cells[:, 1] >= 0)
+        inside &= cells[:, 1] < rows
+        if not inside.all():
+            return False
+        distance = static.distance_m[cells[:, 1], cells[:, 0]]
+        return bool((distance >= self.radius_m).all())
+
+    def set_goal(self, i: int, goal: FloatArray, place: int, now_ns: int) -> None:
+        """Robot ``i`` drives to ``goal`` (m) by way of ``place`` from now."""
+        self.end_goal(i)
+        self.goal[i] = goal
+        self.goal_node[i] = place
+        self.since_ns[i] = now_ns
+
+    def end_goal(self, i: int) -> None:
+        """Robot ``i``'s goal is reached, dropped or cancelled: it settles on its place."""
+        self.goal[i] = np.nan
+        self.goal_node[i] = -1
+        if self.mode[i] == APPROACH:
+            self.mode[i] = SETTLE
+            self.aim[i] = self.roadmap.xy[self.node[i]]
+
+    # -- the step -------------------------------------------------------------------------
+    def step(
+        self, poses: FloatArray, active: BoolArray, progress_ns: IntArray, now_ns: int
+    ) -> tuple[FloatArray, FloatArray]:
+        """Advance holds and plan one PIBT step for the robots standing on a place.
+
+        Args:
+            poses: (n, 3) robot poses in ``map`` (m, m, rad).
+            active: (n,) robots with a goal.
+            progress_ns: (n,) when each robot last made progress (ns).
+            now_ns: simulated time (ns).
+
+        Returns:
+            The (n, 2) point each robot drives to now (m, ``map``), and the (n,) way left
+            to each goal along the places (m).
+        """
+        rm = self.roadmap
+        xy = poses[:, :2]
+        passed = np.hypot(*(xy - self.via).T) < VIA_M
+        self.via[passed] = np.nan
+        gap = np.hypot(*(xy - self.aim).T)
+        moving = (self.mode == MOVE) | (self.mode == SETTLE)
+        landed = moving & np.isnan(self.via[:, 0]) & (gap <= ARRIVE_M)
+        self.mode[landed] = STAND
+        self._release(xy)
+        standing = np.flatnonzero(self.mode == STAND)
+        held: set[int] = set()
+        for i in range(len(xy)):
+            held.update(self.held[i])
+            if self.mode[i] != STAND:
+                held.add(int(self.node[i]))
+        at = {int(i): int(self.node[i]) for i in standing}
+        held -= set(at.values())
+        occupied = set(at.values())
+        goal_node = self.goal_node
+
+        def rank(robot: int, u: int) -> tuple[float, ...]:
+            here = at[robot]
+            if goal_node[robot] < 0:  # no goal: keep to its place, make way when asked
+                return (0.0 if u == here else 1.0, float(u in occupied), float(u))
+            hops = float(self._hops(int(goal_node[robot]))[u])
+            # among equally short ways: a free place, then straight on (a turn is a stop)
+            heading = rm.xy[here] - rm.xy[self.came_from[robot]]
+            turn = float(u != here and float(np.dot(heading, rm.xy[u] - rm.xy[here])) <= 0.0)
+            return (hops, float(u in occupied and u != here), turn, float(u))
+
+        pibt = Pibt(at, rm.neighbours, rank, held)
+        order = self._order(standing, active, progress_ns, now_ns)
+        for i in order:
+            if i in pibt.nxt:
+                continue
+            if goal_node[i] == self.node[i]:
+                self._approach(pibt, i)
+            else:
+                pibt.move(i)
+        for i, u in pibt.nxt.items():
+            if self.mode[i] == APPROACH:
+                continue
+            here = int(self.node[i])
+            if u != here:
+                heading = rm.xy[here] - rm.xy[self.came_from[i]]
+                if self.came_from[i] == here or not np.allclose(heading, rm.xy[u] - rm.xy[here]):
+                    self.via[i] = rm.xy[here]  # a turn: through the centre, no corner cut
+                self.held[i] = [here]
+                self.came_from[i] = here
+                self.node[i] = u
+                self.mode[i] = MOVE
+            self.aim[i] = rm.xy[u]
+        drive = np.where(np.isnan(self.via), self.aim, self.via)
+        # a robot whose next place another robot's body still covers waits on its own
+        owner = {u: j for j in range(len(xy)) for u in self.held[j]}
+        for i in np.flatnonzero(self.mode == MOVE).tolist():
+            j = owner.get(int(self.node[i]))
+            if j is not None and j != i:
+                drive[i] = rm.xy[self.came_from[i]]
+        return drive, self._remaining(xy, active)
+
+    def commands(
+        self,
+        poses: FloatArray,
+        points: FloatArray,
+        v: FloatArray,
+        w: FloatArray,
+        moving: MovingPoints,
+        limits: DriveLimits,
+    ) -> tuple[FloatArray, FloatArray]:
+        """Speed and yaw-rate commands: straight from place to place.
+
+        See :func:`~models.navigation.place_drive.place_drive`; robots settling onto a
+        place from off the grid (at the start) keep the local controller's ``v`` and ``w``.
+        """
+        pv, pw = place_drive(
+            poses, points, limits, self.radius_m, moving.owner, moving.ahead, moving.side
+        )
+        settling = self.mode == SETTLE
+        return np.where(settling, v, pv), np.where(settling, w, pw)
+
+    def _order(
+        self, standing: IntArray, active: BoolArray, progress_ns: IntArray, now_ns: int
+    ) -> list[int]:
+        """Robots standing on a place, first to plan first.
+
+        Stalled for :data:`URGENT_S` (longest first), then by the goal's age, then those
+        without a goal.
+        """
+        with_goal = standing[active[standing] & (self.goal_node[standing] >= 0)]
+        stalled = now_ns - progress_ns[with_goal] >= s_to_ns(URGENT_S)
+        first = np.where(stalled, progress_ns[with_goal], now_ns)
+        order: list[int] = with_goal[
+            np.lexsort((with_goal, self.since_ns[with_goal], first))
+        ].tolist()
+        planned = set(order)
+        return order + [int(i) for i in standing.tolist() if int(i) not in planned]
+
+    def _release(self, xy: FloatArray) -> None:
+        """Let go of the places a robot's body has left (all but its own place)."""
+        rm = self.roadmap
+        for i in range(len(xy)):
+            if not self.held[i] or self.mode[i] == APPROACH:
+                continue
+            keep = [
+                u
+                for u in self.held[i]
+                if u == self.node[i] or np.hypot(*(xy[i] - rm.xy[u])) < RELEASE_M
+            ]
+            self.held[i] = keep
+
+    def _approach(self, pibt: Pibt, i: int) -> None:
+        """Robot ``i`` on its goal's place claims what its body touches at the goal."""
+        here = int(self.node[i])
+        touched = self._touched(self.goal[i], here)
+        if not all(pibt.free(u) or u == here for u in touched):
+            pibt.move(i)  # a robot drives through: wait (or make way) this step
+            return
+        pibt.claim(i, here)
+        pibt.nxt[i] = here
+        others = [pibt.occupant(u) for u in touched[1:]]
+        for u in touched[1:]:
+            pibt.claim(i, u)
+        pushed = [o for o in others if o is not None]
+        for other in pushed:  # ask them to make way: the approach starts once they left
+            pibt.move(other, i)
+        for u in touched[1:]:
+            if pibt.claimed.get(u) == i:
+                del pibt.claimed[u]
+        if pushed:
+            return
+        self.mode[i] = APPROACH
+        self.held[i] = touched
+        self.aim[i] = self.goal[i]
+        self.via[i] = self.roadmap.xy[here]
+
+    def _remaining(self, xy: FloatArray, active: BoolArray) -> FloatArray:
+        """Way left to each goal (m): to the next place, along the places, to the goal."""
+        rm = self.roadmap
+        out = np.zeros(len(xy))
+        for i in np.flatnonzero(active & (self.goal_node >= 0)).tolist():
+            if self.mode[i] == APPROACH:
+                out[i] = float(np.hypot(*(xy[i] - self.goal[i])))
+                continue
+            hops = int(self._hops(int(self.goal_node[i]))[self.node[i]])
+            if hops == UNREACHABLE:
+                out[i] = np.inf
+                continue
+            out[i] = (
+                float(np.hypot(*(xy[i] - self.aim[i])))
+                + hops * rm.spacing_m
+                + float(np.hypot(*(rm.xy[self.goal_node[i]] - self.goal[i])))
+            )
+        return out

@@ -1,0 +1,236 @@
+"""A traffic roadmap of the hall: a square grid of places, each big enough for one robot.
+
+A fleet manager that coordinates robots by reserving space needs a discrete map of that
+space. Here it is a square grid laid over the static map: a node is a place where a robot
+fits with margin (its centre at least ``clearance_m`` from every static obstacle), and two
+4-neighbouring nodes are joined when a robot can drive straight between them with the same
+margin. The spacing is at least a robot's diameter plus a gap, so robots at neighbouring
+nodes do not touch. The grid's offset is chosen among sub-spacing shifts to put nodes in
+as many narrow aisles as possible (an aisle narrower than two spacings holds one line of
+nodes only where the grid happens to fall inside its free band). Edges may be one-way
+(:func:`one_way`): ``neighbours[u, k]`` is then a step robots may take from ``u``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+from scipy import sparse
+from scipy.sparse import csgraph
+from scipy.spatial import cKDTree
+
+from models.arrays import BoolArray, FloatArray, IntArray, UInt8Array
+from models.errors import ModelError
+from models.navigation.lanes import EAST, NORTH, SOUTH, WEST
+
+STEPS: tuple[tuple[int, int], ...] = ((1, 0), (-1, 0), (0, 1), (0, -1))
+"""The four grid moves (dx, dy) in node units; column k of :attr:`Roadmap.neighbours`."""
+Int32Array = npt.NDArray[np.int32]
+UNREACHABLE = np.iinfo(np.int32).max
+"""Hop count of a node that cannot reach the goal."""
+
+
+@dataclass(frozen=True)
+class Roadmap:
+    """Nodes and 4-neighbour edges of the traffic grid.
+
+    Attributes:
+        xy: (m, 2) node centres in ``map`` (m).
+        neighbours: (m, 4) neighbouring node along each of :data:`STEPS`, or -1.
+        spacing_m: distance between neighbouring nodes (m).
+        component: (m,) connected-component label of each node.
+    """
+
+    xy: FloatArray
+    neighbours: IntArray
+    spacing_m: float
+    component: IntArray
+    _tree: cKDTree = field(init=False, repr=False, compare=False)
+    _graph: sparse.csr_matrix = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        m = len(self.xy)
+        rows = np.repeat(np.arange(m), 4)
+        cols = self.neighbours.reshape(-1)
+        keep = cols >= 0
+        graph = sparse.csr_matrix(
+            (np.ones(int(keep.sum())), (rows[keep], cols[keep])), shape=(m, m)
+        )
+        object.__setattr__(self, "_graph", graph)
+        object.__setattr__(self, "_tree", cKDTree(self.xy if m else np.zeros((0, 2))))
+
+    def __len__(self) -> int:
+        return len(self.xy)
+
+    def near(self, point: FloatArray, radius_m: float) -> list[int]:
+        """Nodes whose centres lie within ``radius_m`` of ``point`` (m), nearest first."""
+        found = self._tree.query_ball_point(np.asarray(point, dtype=float), radius_m)
+        return sorted(found, key=lambda k: float(np.hypot(*(self.xy[k] - point))))
+
+    def nearest(self, points: FloatArray, component: int | None = None) -> IntArray:
+        """The node nearest each of (k, 2) points (m), optionally within one component."""
+        pts = np.asarray(points, dtype=float).reshape(-1, 2)
+        if component is None:
+            _, index = self._tree.query(pts)
+            return np.asarray(index, dtype=np.int64)
+        members = np.flatnonzero(self.component == component)
+        d = np.hypot(*(pts[:, None, :] - self.xy[members][None, :, :]).transpose(2, 0, 1))
+        found: IntArray = members[np.argmin(d, axis=1)]
+        return found
+
+    def nearest_k(self, points: FloatArray, k: int) -> IntArray:
+        """(p, k) the ``k`` nodes nearest each of (p, 2) points (m), nearest first."""
+        _, index = self._tree.query(np.asarray(points, dtype=float).reshape(-1, 2), k=k)
+        return np.asarray(index, dtype=np.int64).reshape(len(index), -1)
+
+    def hops_to(self, goal: int) -> Int32Array:
+        """(m,) int32 hops from every node to ``goal`` along the edges' directions.
+
+        :data:`UNREACHABLE` where there is no way.
+        """
+        d = csgraph.shortest_path(self._graph.T.tocsr(), unweighted=True, indices=goal)
+        out = np.full(len(self.xy), UNREACHABLE, dtype=np.int32)
+        finite = np.isfinite(d)
+        out[finite] = d[finite].astype(np.int32)
+        return out
+
+
+def _segment_clear(
+    clear: BoolArray, a: FloatArray, b: FloatArray, origin: tuple[float, float], res: float
+) -> BoolArray:
+    """Whether every costmap cell along each segment ``a[k] -> b[k]`` is clear."""
+    length = float(np.max(np.hypot(*(b - a).T))) if len(a) else 0.0
+    samples = max(2, int(np.ceil(length / (0.5 * res))) + 1)
+    t = np.linspace(0.0, 1.0, samples)
+    pts = a[:, None, :] + (b - a)[:, None, :] * t[None, :, None]
+    ix = np.floor((pts[..., 0] - origin[0]) / res).astype(np.int64)
+    iy = np.floor((pts[..., 1] - origin[1]) / res).astype(np.int64)
+    rows, cols = clear.shape
+    inside = (ix >= 0) & (ix < cols) & (iy >= 0) & (iy < rows)
+    ok = np.zeros(ix.shape, dtype=bool)
+    ok[inside] = clear[iy[inside], ix[inside]]
+    result: BoolArray = np.asarray(ok.all(axis=1))
+    return result
+
+
+def _grid(
+    clear: BoolArray,
+    origin: tuple[float, float],
+    res: float,
+    spacing_m: float,
+    offset: tuple[float, float],
+) -> tuple[FloatArray, IntArray]:
+    """Node centres and neighbours of the grid shifted by ``offset`` (m)."""
+    rows, cols = clear.shape
+    x0 = origin[0] + offset[0]
+    y0 = origin[1] + offset[1]
+    xs = x0 + spacing_m * np.arange(int((cols * res - offset[0]) // spacing_m) + 1)
+    ys = y0 + spacing_m * np.arange(int((rows * res - offset[1]) // spacing_m) + 1)
+    gx, gy = np.meshgrid(xs, ys)
+    centres = np.stack([gx.ravel(), gy.ravel()], axis=1)
+    ix = np.floor((centres[:, 0] - origin[0]) / res).astype(np.int64)
+    iy = np.floor((centres[:, 1] - origin[1]) / res).astype(np.int64)
+    inside = (ix >= 0) & (ix < cols) & (iy >= 0) & (iy < rows)
+    valid = np.zeros(len(centres), dtype=bool)
+    valid[inside] = clear[iy[inside], ix[inside]]
+    flat = np.full(len(centres), -1, dtype=np.int64)
+    flat[valid] = np.arange(int(valid.sum()))
+    index = flat.reshape(len(ys), len(xs))
+    xy = centres[valid]
+    neighbours = np.full((len(xy), 4), -1, dtype=np.int64)
+    node_r, node_c = np.nonzero(index >= 0)
+    for k, (dc, dr) in enumerate(STEPS):
+        r, c = node_r + dr, node_c + dc
+        ok = (r >= 0) & (r < len(ys)) & (c >= 0) & (c < len(xs))
+        other = np.full(len(xy), -1, dtype=np.int64)
+        other[ok] = index[r[ok], c[ok]]
+        linked = other >= 0
+        src = index[node_r, node_c]
+        free = np.zeros(len(xy), dtype=bool)
+        free[linked] = _segment_clear(clear, xy[src[linked]], xy[other[linked]], origin, res)
+        neighbours[src[free], k] = other[free]
+    return xy, neighbours
+
+
+def one_way(
+    roadmap: Roadmap, lanes: UInt8Array, origin: tuple[float, float], res: float
+) -> Roadmap:
+    """The roadmap without the steps against a one-way lane at either end of them.
+
+    Its components are then the strongly connected ones: a robot reaches every place of
+    its own component, and only those.
+
+    Args:
+        roadmap: a two-way roadmap.
+        lanes: (rows, cols) lane direction per costmap cell (:mod:`models.navigation.lanes`).
+        origin: ``map`` position of the lower-left corner of lane cell (0, 0) (m).
+        res: lane cell size (m).
+    """
+    ix = np.floor((roadmap.xy[:, 0] - origin[0]) / res).astype(np.int64)
+    iy = np.floor((roadmap.xy[:, 1] - origin[1]) / res).astype(np.int64)
+    lane = lanes[iy, ix]
+    against = {0: WEST, 1: EAST, 2: SOUTH, 3: NORTH}  # step k is against this lane
+    neighbours = roadmap.neighbours.copy()
+    for k in range(4):
+        other = neighbours[:, k]
+        linked = other >= 0
+        bad = linked & (lane == against[k])
+        bad[linked] |= lane[other[linked]] == against[k]
+        neighbours[bad, k] = -1
+    m = len(roadmap.xy)
+    rows = np.repeat(np.arange(m), 4)
+    cols = neighbours.reshape(-1)
+    keep = cols >= 0
+    graph = sparse.csr_matrix((np.ones(int(keep.sum())), (rows[keep], cols[keep])), shape=(m, m))
+    _, labels = csgraph.connected_components(graph, directed=True, connection="strong")
+    return Roadmap(roadmap.xy, neighbours, roadmap.spacing_m, labels.astype(np.int64))
+
+
+def build_roadmap(
+    distance_m: npt.NDArray[np.floating[Any]],
+    origin_xy_m: tuple[float, float],
+    resolution_m: float,
+    spacing_m: float,
+    clearance_m: float,
+    shifts: int = 8,
+) -> Roadmap:
+    """The traffic grid over a static map.
+
+    Args:
+        distance_m: (rows, cols) distance (m) from each costmap cell centre to the nearest
+            static obstacle, indexed ``[iy, ix]``.
+        origin_xy_m: ``map`` position of the lower-left corner of cell (0, 0) (m).
+        resolution_m: costmap cell size (m).
+        spacing_m: node spacing (m), at least a robot's diameter plus a gap.
+        clearance_m: least distance (m) from a node, or an edge, to any static obstacle.
+        shifts: offsets tried per axis (``spacing_m / shifts`` apart).
+
+    Raises:
+        ModelError: if no offset leaves a single node.
+    """
+    clear = np.asarray(distance_m) >= clearance_m
+    best: tuple[int, FloatArray, IntArray] | None = None
+    for sx in range(shifts):
+        for sy in range(shifts):
+            offset = (spacing_m * (sx + 0.5) / shifts, spacing_m * (sy + 0.5) / shifts)
+            xy, neighbours = _grid(clear, origin_xy_m, resolution_m, spacing_m, offset)
+            score = int((neighbours >= 0).sum())  # edges: nodes that connect
+            if best is None or score > best[0]:
+                best = (score, xy, neighbours)
+    if best is None or len(best[1]) == 0:
+        raise ModelError(
+            "navigation.traffic",
+            "pibt",
+            f"a floor with room for a {spacing_m:g} m grid of robot places",
+        )
+    _, xy, neighbours = best
+    m = len(xy)
+    rows = np.repeat(np.arange(m), 4)
+    cols = neighbours.reshape(-1)
+    keep = cols >= 0
+    graph = sparse.csr_matrix((np.ones(int(keep.sum())), (rows[keep], cols[keep])), shape=(m, m))
+    _, labels = csgraph.connected_components(graph, directed=False)
+    return Roadmap(xy, neighbours, spacing_m, labels.astype(np.int64))

@@ -1,0 +1,67 @@
+"""``navigation.traffic = "pibt"``: the fleet manager moving robots place by place."""
+
+import numpy as np
+import pytest
+
+import adapters.navigation.fleet_traffic as fleet_traffic
+import cosim
+from adapters.navigation.fleet_traffic import STAND, FleetTraffic
+from models.errors import ModelError
+from models.navigation.costmap import CostmapParams, StaticCostmap
+from models.navigation.lanes import TWO_WAY
+from models.occupancy import OccupancyGrid
+
+
+def _pibt_fleet(count: int, duration_s: float) -> cosim.Scenario:
+    return cosim.load_scenario(
+        "fleet50",
+        {
+            "navigation.traffic": "pibt",
+            "robots.count": count,
+            "scenario.duration_s": duration_s,
+            "record.bag": "none",
+        },
+    )
+
+
+def test_robots_on_places_reach_goals_without_collision_and_never_share_a_place(monkeypatch):
+    shared: list[float] = []
+    step = FleetTraffic.step
+
+    def checked(self, poses, active, progress_ns, now_ns):
+        out = step(self, poses, active, progress_ns, now_ns)
+        if len(set(self.node.tolist())) < len(self.node):
+            shared.append(now_ns / 1e9)
+        standing = self.mode == STAND
+        assert (
+            np.hypot(*(poses[standing, :2] - self.roadmap.xy[self.node[standing]]).T)
+            <= fleet_traffic.ARRIVE_M + 1e-9
+        ).all()
+        return out
+
+    monkeypatch.setattr(FleetTraffic, "step", checked)
+    result = cosim.run(_pibt_fleet(16, 60.0))
+    assert shared == []
+    summary = result.summary
+    assert summary["collisions"] == 0
+    assert summary["arrivals"] >= 10
+    assert summary["goals_missed"] == 0
+    # no A* on the way: the fleet manager moves them, robots plan nothing themselves
+    assert result.tables["navigation"].query("event in ['plan', 'replan']").empty
+
+
+def test_the_same_seed_gives_the_same_tables_with_places():
+    first = cosim.run(_pibt_fleet(8, 20.0)).deterministic_tables()
+    second = cosim.run(_pibt_fleet(8, 20.0)).deterministic_tables()
+    for name, frame in first.items():
+        assert second[name].equals(frame), name
+
+
+def test_a_fleet_with_more_robots_than_places_is_refused_naming_the_key():
+    occupancy = np.zeros((30, 30), dtype=np.int8)  # 3 m x 3 m
+    occupancy[0, :] = occupancy[-1, :] = occupancy[:, 0] = occupancy[:, -1] = 100
+    static = StaticCostmap.from_grid(OccupancyGrid(0.1, (0.0, 0.0), occupancy), CostmapParams(0.33))
+    lanes = np.full(static.cost.shape, TWO_WAY, dtype=np.uint8)
+    positions = np.full((20, 2), 1.5)
+    with pytest.raises(ModelError, match=r"robots\.count"):
+        FleetTraffic(static, lanes, positions, 0.33)

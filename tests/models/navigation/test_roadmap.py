@@ -1,0 +1,84 @@
+"""The traffic roadmap: robot-sized places, clear edges, one-way aisles."""
+
+import numpy as np
+import pytest
+from scipy import ndimage
+
+from models.errors import ModelError
+from models.navigation.lanes import EAST, TWO_WAY
+from models.navigation.roadmap import STEPS, UNREACHABLE, build_roadmap, one_way
+
+RES = 0.1
+CLEARANCE = 0.43  # a 0.33 m robot and a 0.1 m margin
+
+
+def _distance(obstacle: np.ndarray) -> np.ndarray:
+    """Distance (m) from each cell centre to the nearest obstacle cell centre."""
+    return ndimage.distance_transform_edt(~obstacle) * RES
+
+
+def _hall_with_a_box() -> np.ndarray:
+    obstacle = np.zeros((80, 100), dtype=bool)  # 10 m x 8 m
+    obstacle[0, :] = obstacle[-1, :] = obstacle[:, 0] = obstacle[:, -1] = True
+    obstacle[30:50, 40:60] = True
+    return obstacle
+
+
+def _racks() -> np.ndarray:
+    """A 10 m x 8 m hall with two 6 m racks 0.8 m deep and a 1.6 m aisle between them."""
+    obstacle = np.zeros((80, 100), dtype=bool)
+    obstacle[0, :] = obstacle[-1, :] = obstacle[:, 0] = obstacle[:, -1] = True
+    obstacle[20:28, 20:80] = obstacle[44:52, 20:80] = True
+    return obstacle
+
+
+def test_places_keep_their_clearance_and_edges_join_neighbours_a_spacing_apart_on_clear_ground():
+    obstacle = _hall_with_a_box()
+    distance = _distance(obstacle)
+    roadmap = build_roadmap(distance, (0.0, 0.0), RES, 0.8, CLEARANCE)
+    ix = np.floor(roadmap.xy[:, 0] / RES).astype(int)
+    iy = np.floor(roadmap.xy[:, 1] / RES).astype(int)
+    assert (distance[iy, ix] >= CLEARANCE).all()
+    for k, (dx, dy) in enumerate(STEPS):
+        linked = np.flatnonzero(roadmap.neighbours[:, k] >= 0)
+        other = roadmap.neighbours[linked, k]
+        assert np.allclose(roadmap.xy[other] - roadmap.xy[linked], (0.8 * dx, 0.8 * dy))
+        for t in np.linspace(0, 1, 17):  # every point of every edge keeps the clearance
+            p = roadmap.xy[linked] + t * (roadmap.xy[other] - roadmap.xy[linked])
+            cells = np.floor(p / RES).astype(int)
+            assert (distance[cells[:, 1], cells[:, 0]] >= CLEARANCE).all()
+    assert len(set(roadmap.component.tolist())) == 1  # round the box: one piece
+
+
+def test_the_grid_is_shifted_to_put_a_line_of_places_along_a_narrow_aisle():
+    roadmap = build_roadmap(_distance(_racks()), (0.0, 0.0), RES, 0.8, CLEARANCE)
+    in_aisle = (roadmap.xy[:, 1] > 2.8) & (roadmap.xy[:, 1] < 4.4)
+    in_aisle &= (roadmap.xy[:, 0] > 2.0) & (roadmap.xy[:, 0] < 8.0)
+    assert in_aisle.sum() >= 7  # a line of places along the 6 m aisle
+    along = roadmap.xy[in_aisle]
+    assert np.ptp(along[:, 1]) == 0.0
+
+
+def test_a_floor_without_room_for_a_single_place_is_refused():
+    with pytest.raises(ModelError, match=r"navigation\.traffic"):
+        build_roadmap(np.full((5, 5), 0.2), (0.0, 0.0), RES, 0.8, CLEARANCE)
+
+
+def test_one_way_aisles_lose_their_backward_steps_and_hops_follow_the_directions():
+    obstacle = _racks()
+    roadmap = build_roadmap(_distance(obstacle), (0.0, 0.0), RES, 0.8, CLEARANCE)
+    lanes = np.full(obstacle.shape, TWO_WAY, dtype=np.uint8)
+    lanes[28:44, 20:80] = EAST  # the aisle between the racks, the way round two-way
+    directed = one_way(roadmap, lanes, (0.0, 0.0), RES)
+    row = np.flatnonzero((directed.xy[:, 1] > 2.8) & (directed.xy[:, 1] < 4.4))
+    inner = row[(directed.xy[row, 0] > 2.5) & (directed.xy[row, 0] < 7.5)]
+    assert (directed.neighbours[inner, 1] == -1).all()  # no step west in an east aisle
+    assert (directed.neighbours[inner, 0] >= 0).all()  # east is fine
+    west, east = inner[np.argmin(directed.xy[inner, 0])], inner[np.argmax(directed.xy[inner, 0])]
+    hops_east = directed.hops_to(int(east))
+    hops_west = directed.hops_to(int(west))
+    straight = round((directed.xy[east, 0] - directed.xy[west, 0]) / 0.8)
+    assert hops_east[west] == straight  # down the aisle
+    assert hops_west[east] > straight  # back round the racks
+    assert hops_west[east] != UNREACHABLE
+    assert len(set(directed.component.tolist())) == 1  # still one strongly connected piece
