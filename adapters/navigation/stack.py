@@ -31,6 +31,7 @@ from adapters.naming import topic
 from adapters.navigation.fleet_traffic import FleetTraffic
 from adapters.navigation.layers import StaticLayer, StaticLayers, lanes_on
 from adapters.navigation.localization import MeasuredPoses
+from adapters.navigation.planning import GlobalPlanning
 from adapters.navigation.records import NavRecords
 from adapters.navigation.recovery import Recovery, StallWatch, stuck_kind
 from adapters.navigation.robots_layer import RobotsLayer
@@ -55,42 +56,26 @@ from cosim.timebase import NS_PER_S, period_ns, s_to_ns
 from models.kinematics import FleetState
 from models.lidar import ScanGeometry
 from models.mapping.se2 import compose
-from models.navigation.costmap import CostmapParams, StaticCostmap, with_obstacles
+from models.navigation.costmap import CostmapParams, StaticCostmap
 from models.navigation.dwa import DwaParams, dwa_batch
-from models.navigation.follow import PathBook, paths_blocked
-from models.navigation.landmarks import ALT_MIN_CELLS, LandmarkCache
-from models.navigation.lanes import in_lanes
+from models.navigation.follow import PathBook
 from models.navigation.planner import (
     GoalStatus,
     goal_status,
-    path_to_world,
-    plan,
-    prune_path,
-    shortest_path_length_m,
 )
-from models.navigation.repair import RepairParams, repair_path
 from models.navigation.traffic import TrafficParams, keep_right, moving_points, speed_caps
 from models.occupancy import ground_truth_grid
 from models.world import Warehouse
 
 PROGRESS_M = 0.2
 """Remaining path length must shrink by this much to count as progress (m)."""
-PATH_CLEARANCE_M = 0.3
-"""A moving thing closer than footprint plus this to the path ahead calls for a replan (m)."""
 HALT_MPS = 0.02
 """Commanded speed below which a robot with a goal counts as halted (m/s)..."""
-REPAIR_DETOUR_M = 2.0
-"""A repair lengthening the way by more than this is checked against a full replan (m)."""
 LANE_WIDTH_M = 2.5
 """``traffic = "lanes"`` and ``"pibt"``: aisles up to this wide are one-way (m); two robots
 pass in wider."""
-LANE_AGAINST = 5.0
-"""``traffic = "lanes"``: a step against an aisle's direction costs this many times more."""
 HALT_RADPS = 0.05
 """...when it does not turn faster than this either (rad/s)."""
-Found = tuple[tuple[np.ndarray, float] | None, str, np.ndarray]
-"""A plan's outcome: the route ``(waypoints, length_m)`` or None, how it was found, and the
-moving things planned round."""
 
 
 class NavigationAdapter:
@@ -142,11 +127,6 @@ class NavigationAdapter:
                 radius,
             )
         run.provide(self.static)
-        # A*'s landmark bounds on the shared static layer, built on first use, on floors
-        # large enough for the fleet's plans to pay for them (see _full for where they hold)
-        self.landmarks = (
-            LandmarkCache(self.static) if self.static.cost.size >= ALT_MIN_CELLS else None
-        )
         self.measured = MeasuredPoses(run, self.names)
         """Robots localizing by motion capture (or their own reported pose)."""
         self.correction = [(0.0, 0.0, 0.0)] * len(self.names)
@@ -158,7 +138,6 @@ class NavigationAdapter:
         angles = _beam_angles(lidar.beams, math.radians(lidar.fov_deg))
         self.memory = ScanMemory(n, angles, lidar.range_max_m)
         self.moving = MovingMemory(s_to_ns(cfg.obstacle_memory_s), self.layers.resolution_m)
-        self.planned_around = np.zeros(n, dtype=bool)
         self.near_m = self.limits.max_speed_mps * self.dwa.sim_time_s + radius + 1.0
         self.paths = PathBook(n)
         self.pose = np.stack([self.fleet.x, self.fleet.y, self.fleet.yaw], axis=1)
@@ -166,7 +145,6 @@ class NavigationAdapter:
         self.active = np.zeros(n, dtype=bool)
         self.goal = np.zeros((n, 2))
         self.goal_id = np.zeros(n, dtype=np.int64)
-        self.next_plan_ns = np.zeros(n, dtype=np.int64)
         self.best_remaining = np.full(n, np.inf)
         self.progress_ns = np.zeros(n, dtype=np.int64)
         self.progress_driven_m = np.zeros(n)  # distance driven at the last progress
@@ -182,7 +160,6 @@ class NavigationAdapter:
         self.radius = radius
         self.rngs = [run.rng.stream(f"navigation/{name}") for name in self.names]
         self.traffic = TrafficParams()
-        self.repair = RepairParams()
         self.recovery = Recovery(n, self.memory, self.limits, radius, self.rngs)
         self.stalls = StallWatch(self.pose)
         self.status_topics = [topic(n, "nav/status") for n in self.names]
@@ -197,6 +174,24 @@ class NavigationAdapter:
             bus.advertise(path, Path)
         if self.robots_layer is not None:
             self.robots_layer.advertise(run)
+        self.planning = GlobalPlanning(
+            static=self.static,
+            layers=self.layers,
+            lanes=self.lanes,
+            memory=self.memory,
+            moving=self.moving,
+            robots_layer=self.robots_layer,
+            paths=self.paths,
+            pose=self.pose,
+            goal=self.goal,
+            radius_m=radius,
+            inflation_m=cfg.inflation_radius_m,
+            replan_hz=cfg.replan_hz,
+            mapping=self.mapping,
+            records=self.records,
+            hosts=self.hosts,
+            plan_topics=self.plan_topics,
+        )
 
     # -- the bus ----------------------------------------------------------------------
     def start(self, run: RunContext) -> None:
@@ -318,7 +313,7 @@ class NavigationAdapter:
             places.set_goal(i, self.goal[i], place, now)
             return
         started = time.perf_counter()
-        found = self._route(i, now, replan=False)
+        found = self.planning.route(i, now, replan=False)
         route = found[0]
         if deferred and route is None:
             shortest = self._yardstick(i)
@@ -326,7 +321,7 @@ class NavigationAdapter:
                 self._drop(run, i, "unreachable", "enclosed")
                 return
         self._begin(run, i, now, shortest, shortest if route is None or not deferred else route[1])
-        self._finish_plan(run, i, now, found, started, replan=False)
+        self.planning.finish(run, i, now, found, started, replan=False)
 
     def _begin(self, run: RunContext, i: int, now: int, shortest: float, way: float) -> None:
         """Robot ``i`` drives to its goal from now; ``way`` (m) goes out as accepted."""
@@ -342,10 +337,7 @@ class NavigationAdapter:
 
     def _yardstick(self, i: int) -> float:
         """Robot ``i``'s shortest way (m) on the true map from where its goal started."""
-        marks = None if self.landmarks is None else self.landmarks.get(0.0)
-        return shortest_path_length_m(
-            self.static, self.yardstick_from[i], self.goal[i], landmarks=marks
-        )
+        return self.planning.yardstick(self.yardstick_from[i], self.goal[i])
 
     def _drop(self, run: RunContext, i: int, state: str, detail: str = "") -> None:
         self.active[i] = False
@@ -356,137 +348,6 @@ class NavigationAdapter:
             run.kernel.now_ns, i, state, self.goal[i, 0], self.goal[i, 1], detail=detail
         )
         self._status(run, i, state, math.nan)
-
-    def _obstacles_for_plan(self, i: int, now_ns: int) -> tuple[np.ndarray, np.ndarray]:
-        res = self.layers.resolution_m
-        points = self.moving.recall(i, res)
-        points = points[~self.memory.seen_through(i, points, 2 * res)]
-        if self.lanes is not None and len(points):
-            # in a one-way aisle whatever moves goes the robot's way: it is traffic to
-            # follow (the local controller keeps the distance), not a wall to plan round
-            points = points[~in_lanes(self.lanes, points, self.layers.origin_xy_m, res)]
-        no_discs = np.zeros((0, 3))
-        discs = no_discs if self.robots_layer is None else self.robots_layer.discs(i, now_ns)
-        return points, discs
-
-    def _plan(self, run: RunContext, i: int, now_ns: int, *, replan: bool) -> bool:
-        started = time.perf_counter()
-        found = self._route(i, now_ns, replan=replan)
-        self._finish_plan(run, i, now_ns, found, started, replan=replan)
-        return found[0] is not None
-
-    def _route(self, i: int, now_ns: int, *, replan: bool) -> Found:
-        """A new route for robot ``i`` (:data:`Found`), not followed yet."""
-        points, discs = self._obstacles_for_plan(i, now_ns)
-        layer = self.layers[i]
-        # a robot mapping as it goes plans in full: the rest of its old path was planned on
-        # an older map, through space that may since have turned out to be wall
-        repair = replan and not self.mapping and self.paths.lengths[i] >= 2
-        nothing = np.zeros((0, 2))
-        # with what it sees, then as Nav2's "clear costmap" recovery does on the static
-        # layer alone (leaving the robots and people in the way to the local controller);
-        # each first as a repair of the stretch ahead, then in full; a repair that makes
-        # the way much longer than it was is checked against a full replan (another aisle
-        # may be shorter than the detour round a jam)
-        route = None
-        detail = ""
-        was = float(self.paths.follow_one(i, self.pose[i, 0], self.pose[i, 1])) if repair else 0.0
-        for seen, near, detail in ((points, discs, ""), (nothing, np.zeros((0, 3)), "cleared")):
-            route = self._repair(i, layer, seen, near) if repair else None
-            if route is not None and route[1] <= was + REPAIR_DETOUR_M:
-                detail = f"{detail} repaired".strip()
-                break
-            repaired, route = route, self._full(i, layer, seen, near)
-            if route is None and repaired is not None:
-                route, detail = repaired, f"{detail} repaired".strip()
-            if route is not None:
-                break
-        return route, detail, points
-
-    def _finish_plan(
-        self, run: RunContext, i: int, now_ns: int, found: Found, started: float, *, replan: bool
-    ) -> None:
-        """Follow a found route (or retry at the next replan) and record the plan."""
-        route, detail, points = found
-        if route is not None:
-            self._set_path(run, i, now_ns, route[0], points)
-        else:
-            self.next_plan_ns[i] = now_ns + period_ns(self.cfg.replan_hz)
-        self.records.row(
-            now_ns,
-            i,
-            "replan" if replan else "plan",
-            self.goal[i, 0],
-            self.goal[i, 1],
-            path_length_m=route[1] if route is not None else math.nan,
-            plan_ms=(time.perf_counter() - started) * 1e3,
-            detail=detail if route is not None else "no path",
-        )
-
-    def _repair(
-        self, i: int, layer: StaticCostmap, points: np.ndarray, discs: np.ndarray
-    ) -> tuple[np.ndarray, float] | None:
-        """The path with its stretch ahead replanned in a window, or None."""
-        repaired = repair_path(
-            layer,
-            points,
-            discs if len(discs) else None,
-            self.paths.waypoints(i),
-            int(self.paths.segment[i]),
-            self.pose[i, :2],
-            self.repair,
-            lanes=self.lanes,
-            against=LANE_AGAINST,
-        )
-        return None if repaired is None else (repaired.waypoints, repaired.length_m)
-
-    def _full(
-        self, i: int, layer: StaticCostmap, points: np.ndarray, discs: np.ndarray
-    ) -> tuple[np.ndarray, float] | None:
-        """A path from the robot to its goal over the whole map, or None."""
-        cost = with_obstacles(layer, points, discs=discs if len(discs) else None)
-        s_cell = layer.world_to_cell(self.pose[i, :2])
-        g_cell = layer.world_to_cell(self.goal[i])
-        marks = None
-        if self.landmarks is not None and layer is self.static:
-            marks = self.landmarks.get(1.0)  # not on a map the robot builds: other costs
-        result = plan(
-            cost,
-            s_cell,
-            g_cell,
-            resolution_m=layer.resolution_m,
-            lanes=self.lanes,
-            against=LANE_AGAINST,
-            landmarks=marks,
-        )
-        if not result.found:
-            return None
-        waypoints = path_to_world(layer, prune_path(cost, result.cells))
-        waypoints[-1] = self.goal[i]
-        return waypoints, result.length_m
-
-    def _set_path(
-        self,
-        run: RunContext,
-        i: int,
-        now_ns: int,
-        waypoints: np.ndarray,
-        points: np.ndarray,
-    ) -> None:
-        self.paths.set(i, waypoints)
-        # Nav2's planner publishes every plan it makes on `plan` (for tools; nothing here
-        # subscribes)
-        run.bus.publish(self.plan_topics[i], Path(now_ns, "map", waypoints.copy()), self.hosts[i])
-        # moving things the new path bends around: replan while they may leave
-        shaped = paths_blocked(
-            self.paths,
-            np.full(len(points), i),
-            points,
-            self.radius + self.cfg.inflation_radius_m,
-            len(waypoints),
-        )
-        self.planned_around[i] = bool(shaped[i])
-        self.next_plan_ns[i] = now_ns + period_ns(self.cfg.replan_hz)
 
     # -- the control tick -------------------------------------------------------------------
     def _control(self, run: RunContext, now_ns: int) -> None:
@@ -505,19 +366,8 @@ class NavigationAdapter:
             self.traffic,
         )
         self.moving.remember(now_ns, moving.owner, moving.points)
-        due = self.active & (now_ns >= self.next_plan_ns) & (self.places is None)
-        if due.any():
-            # periodic replans only when the costmap changed where it matters: something
-            # moving on the path ahead now, or around the last plan (Nav2 replans at 1 Hz
-            # whatever happens; without a change the result is the same path)
-            on_path = paths_blocked(
-                self.paths, moving.owner, moving.points, self.radius + PATH_CLEARANCE_M
-            )
-            for i in np.flatnonzero(due).tolist():
-                if self.planned_around[i] or on_path[i]:
-                    self._plan(run, i, now_ns, replan=True)
-                else:
-                    self.next_plan_ns[i] = now_ns + period_ns(self.cfg.replan_hz)
+        if self.places is None:
+            self.planning.replan_due(run, now_ns, self.active, moving)
         goals = self.goal
         if self.places is None:
             carrots, remaining = self.paths.follow(
@@ -571,7 +421,7 @@ class NavigationAdapter:
             moving_ok,
             v,
             w,
-            lambda i: self._plan(run, i, now_ns, replan=True),
+            lambda i: self.planning.plan(run, i, now_ns, replan=True),
             lambda i, kind: self.records.row(
                 now_ns, i, "recovery", self.goal[i, 0], self.goal[i, 1], detail=kind
             ),

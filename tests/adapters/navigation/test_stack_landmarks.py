@@ -1,6 +1,6 @@
 import pytest
 
-import adapters.navigation.stack as stack
+import adapters.navigation.planning as planning
 import cosim
 from models.navigation.landmarks import Landmarks
 
@@ -14,9 +14,9 @@ FLEET = {
 
 def _spy(monkeypatch: pytest.MonkeyPatch, min_cells: int) -> list[tuple[str, Landmarks | None]]:
     """Lower or raise the size threshold; record the landmarks every search is given."""
-    monkeypatch.setattr(stack, "ALT_MIN_CELLS", min_cells)
+    monkeypatch.setattr(planning, "ALT_MIN_CELLS", min_cells)
     calls: list[tuple[str, Landmarks | None]] = []
-    plan, yardstick = stack.plan, stack.shortest_path_length_m
+    plan, yardstick = planning.plan, planning.shortest_path_length_m
 
     def spy_plan(*args, **kwargs):
         calls.append(("plan", kwargs.get("landmarks")))
@@ -26,8 +26,8 @@ def _spy(monkeypatch: pytest.MonkeyPatch, min_cells: int) -> list[tuple[str, Lan
         calls.append(("yardstick", kwargs.get("landmarks")))
         return yardstick(*args, **kwargs)
 
-    monkeypatch.setattr(stack, "plan", spy_plan)
-    monkeypatch.setattr(stack, "shortest_path_length_m", spy_yardstick)
+    monkeypatch.setattr(planning, "plan", spy_plan)
+    monkeypatch.setattr(planning, "shortest_path_length_m", spy_yardstick)
     return calls
 
 
@@ -51,7 +51,7 @@ def test_above_the_size_threshold_every_robot_plans_with_the_same_landmarks(monk
     assert len({id(m) for m in plans}) == 1 and len({id(m) for m in yardsticks}) == 1  # shared
     # the same goals, planned to paths of the same cost (equal-cost paths may differ)
     calls.clear()
-    monkeypatch.setattr(stack, "ALT_MIN_CELLS", 10**12)
+    monkeypatch.setattr(planning, "ALT_MIN_CELLS", 10**12)
     plain = cosim.run(cosim.load_scenario("fleet50", fleet))
     assert all(marks is None for _, marks in calls)
     assert fast.summary["goals_sent"] == plain.summary["goals_sent"]
@@ -62,7 +62,7 @@ def test_above_the_size_threshold_every_robot_plans_with_the_same_landmarks(monk
 
 
 def test_on_fleet50s_floor_the_landmarks_are_not_built(monkeypatch):
-    calls = _spy(monkeypatch, stack.ALT_MIN_CELLS)
+    calls = _spy(monkeypatch, planning.ALT_MIN_CELLS)
     result = cosim.run(cosim.load_scenario("fleet50", {**FLEET, "scenario.duration_s": 1.0}))
     assert result.summary["goals"] == 6
     assert calls and all(marks is None for _, marks in calls)
