@@ -236,7 +236,7 @@ class Chatter:
 BREAKDOWN = {
     "lidar (cast, noise, scan messages)": ("adapters/sensing/lidar.py", "_scan"),
     "navigation control tick (all below)": ("adapters/navigation/stack.py", "_control"),
-    "  global planning (A*, costmap, memory)": ("adapters/navigation/stack.py", "_plan"),
+    "  global planning (A*, costmap, memory)": ("adapters/navigation/planning.py", "plan"),
     "  local control (DWA kernel)": ("models/navigation/dwa.py", "dwa_batch"),
     "physics tick (kinematics, collisions, odometry)": ("adapters/fleet/motion.py", "_tick"),
     "  collision checks": ("adapters/fleet/collisions.py", "guard"),
