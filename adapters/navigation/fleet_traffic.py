@@ -9,9 +9,11 @@ or has claimed, asking a robot standing there to make way. A robot drives to its
 place (:mod:`models.navigation.place_drive`: turn on the spot, then straight) and holds
 the place it left until its body is :data:`RELEASE_M` away from it; a robot that follows
 waits on its own place until then. Within :data:`ARRIVE_M` of its new place it takes its
-next step, so a robot going straight on does not stop. On its goal's place it claims
-every place its body will touch at the goal and drives there; after the goal it settles
-back on the place.
+next step, so a robot going straight on does not stop; among equally short ways it
+prefers a free place, then straight on (a turn is a stop: +19 % goals reached in fleet50).
+A goal is reached from the nearest place within :data:`GOAL_REACH` spacings with a clear
+straight way to it: on that place the robot claims every place its body will touch on the
+way and drives to the goal; after the goal it settles back on the place.
 
 Priorities: PIBT's rule (Okumura et al. 2022) is the goal's age, which always lets the
 robot waiting longest move nearer; here a robot that has made no progress for
