@@ -39,6 +39,7 @@ from models.navigation.roadmap import (
     Roadmap,
     build_roadmap,
     one_way,
+    segment_clear,
 )
 from models.navigation.traffic import MovingPoints
 
@@ -86,7 +87,8 @@ class FleetTraffic:
         self, static: StaticCostmap, lanes: UInt8Array, poses: FloatArray, radius_m: float
     ) -> None:
         self.radius_m = radius_m
-        self.static = static
+        self.footprint_clear = static.distance_m >= radius_m  # cells a robot centre may be on
+        self.grid = (static.origin_xy_m, static.resolution_m)
         self.spacing_m = 2 * radius_m + GAP_M
         self.reach_m = 2 * radius_m + GAP_M / 2  # places a robot at a point touches
         self.roadmap: Roadmap = build_roadmap(
@@ -155,23 +157,9 @@ class FleetTraffic:
         mine = np.flatnonzero(rm.component == rm.component[self.node[i]])
         d = np.hypot(*(rm.xy[mine] - goal).T)
         for u in mine[np.argsort(d)][: int(np.sum(d <= GOAL_REACH * rm.spacing_m))]:
-            if self._clear(rm.xy[u], goal):
+            if segment_clear(self.footprint_clear, rm.xy[u][None], goal[None], *self.grid)[0]:
                 return int(u)
         return -1
-
-    def _clear(self, a: FloatArray, b: FloatArray) -> bool:
-        """Whether a robot driving straight from ``a`` to ``b`` keeps off static obstacles."""
-        static = self.static
-        steps = max(2, int(np.ceil(np.hypot(*(b - a)) / static.resolution_m)) + 1)
-        points = a + np.linspace(0.0, 1.0, steps)[:, None] * (b - a)
-        cells = np.floor((points - static.origin_xy_m) / static.resolution_m).astype(np.int64)
-        rows, cols = static.distance_m.shape
-        inside = (cells[:, 0] >= 0) & (cells[:, 0] < cols) & (cells[:, 1] >= 0)
-        inside &= cells[:, 1] < rows
-        if not inside.all():
-            return False
-        distance = static.distance_m[cells[:, 1], cells[:, 0]]
-        return bool((distance >= self.radius_m).all())
 
     def set_goal(self, i: int, goal: FloatArray, place: int, now_ns: int) -> None:
         """Robot ``i`` drives to ``goal`` (m) by way of ``place`` from now."""
@@ -269,21 +257,29 @@ class FleetTraffic:
         self,
         poses: FloatArray,
         points: FloatArray,
-        v: FloatArray,
-        w: FloatArray,
+        settle: tuple[FloatArray, FloatArray, BoolArray] | None,
         moving: MovingPoints,
         limits: DriveLimits,
     ) -> tuple[FloatArray, FloatArray]:
         """Speed and yaw-rate commands: straight from place to place.
 
-        See :func:`~models.navigation.place_drive.place_drive`; robots settling onto a
-        place from off the grid (at the start) keep the local controller's ``v`` and ``w``.
+        See :func:`~models.navigation.place_drive.place_drive`. Robots settling onto a
+        place from off it (at the start, after a goal) take the local controller's speed
+        and yaw rate from ``settle`` (needed when any robot is :attr:`settling`).
         """
-        pv, pw = place_drive(
+        v, w = place_drive(
             poses, points, limits, self.radius_m, moving.owner, moving.ahead, moving.side
         )
-        settling = self.mode == SETTLE
-        return np.where(settling, v, pv), np.where(settling, w, pw)
+        if settle is None:
+            return v, w
+        settling = self.settling
+        return np.where(settling, settle[0], v), np.where(settling, settle[1], w)
+
+    @property
+    def settling(self) -> BoolArray:
+        """(n,) robots settling onto a place from off it."""
+        settling: BoolArray = self.mode == SETTLE
+        return settling
 
     def _order(
         self, standing: IntArray, active: BoolArray, progress_ns: IntArray, now_ns: int
@@ -344,17 +340,21 @@ class FleetTraffic:
         """Way left to each goal (m): to the next place, along the places, to the goal."""
         rm = self.roadmap
         out = np.zeros(len(xy))
-        for i in np.flatnonzero(active & (self.goal_node >= 0)).tolist():
-            if self.mode[i] == APPROACH:
-                out[i] = float(np.hypot(*(xy[i] - self.goal[i])))
-                continue
-            hops = int(self._hops(int(self.goal_node[i]))[self.node[i]])
-            if hops == UNREACHABLE:
-                out[i] = np.inf
-                continue
-            out[i] = (
-                float(np.hypot(*(xy[i] - self.aim[i])))
-                + hops * rm.spacing_m
-                + float(np.hypot(*(rm.xy[self.goal_node[i]] - self.goal[i])))
-            )
+        going = np.flatnonzero(active & (self.goal_node >= 0))
+        if not len(going):
+            return out
+        goal_node = self.goal_node[going]
+        hops = np.array(
+            [self._hops(int(g))[u] for g, u in zip(goal_node, self.node[going], strict=True)],
+            dtype=float,
+        )
+        hops[hops == UNREACHABLE] = np.inf
+        goal = self.goal[going]
+        along = (
+            np.hypot(*(xy[going] - self.aim[going]).T)
+            + hops * rm.spacing_m
+            + np.hypot(*(rm.xy[goal_node] - goal).T)
+        )
+        approaching = self.mode[going] == APPROACH
+        out[going] = np.where(approaching, np.hypot(*(xy[going] - goal).T), along)
         return out

@@ -63,7 +63,13 @@ from models.navigation.planner import (
     GoalStatus,
     goal_status,
 )
-from models.navigation.traffic import TrafficParams, keep_right, moving_points, speed_caps
+from models.navigation.traffic import (
+    MovingPoints,
+    TrafficParams,
+    keep_right,
+    moving_points,
+    speed_caps,
+)
 from models.occupancy import ground_truth_grid
 from models.world import Warehouse
 
@@ -366,17 +372,76 @@ class NavigationAdapter:
             self.traffic,
         )
         self.moving.remember(now_ns, moving.owner, moving.points)
-        if self.places is None:
-            self.planning.replan_due(run, now_ns, self.active, moving)
-        goals = self.goal
-        if self.places is None:
-            carrots, remaining = self.paths.follow(
-                self.pose[:, 0], self.pose[:, 1], self.cfg.lookahead_m
-            )
-            carrots = keep_right(carrots, moving, self.pose, self.active, self.traffic)
-        else:  # the point each robot drives to now (robots settling slow onto it)
-            carrots, remaining = self.places.step(self.pose, self.active, self.progress_ns, now_ns)
-            goals = carrots
+        # a robot without a recent pose does not know where it is: it stops
+        lost = self.measured.check(now_ns)
+        if self.places is not None:
+            self._control_places(run, now_ns, self.places, points, start, moving, lost)
+            return
+        self.planning.replan_due(run, now_ns, self.active, moving)
+        carrots, remaining = self.paths.follow(
+            self.pose[:, 0], self.pose[:, 1], self.cfg.lookahead_m
+        )
+        carrots = keep_right(carrots, moving, self.pose, self.active, self.traffic)
+        v, w, blocked = self._local_control(carrots, self.goal, points, start, moving, now_ns)
+        moving_ok = self.active & ~lost
+        v = np.where(moving_ok, v, 0.0)
+        w_cmd = np.where(moving_ok, w, 0.0)
+        self._track_progress(run, now_ns, remaining)
+        # halted: the controller found nothing admissible ahead, or chose to stand still
+        # (a robot in the way) while its goal is elsewhere
+        halted = blocked | ((np.abs(v) < HALT_MPS) & (np.abs(w) < HALT_RADPS))
+        # ...or has hardly moved for a while whatever it commanded (dithering nose to nose)
+        halted |= self.stalls.update(now_ns, self.pose, self.active)
+        self.recovery.apply(
+            now_ns,
+            halted,
+            moving_ok,
+            v,
+            w_cmd,
+            lambda i: self.planning.plan(run, i, now_ns, replan=True),
+            lambda i, kind: self.records.row(
+                now_ns, i, "recovery", self.goal[i, 0], self.goal[i, 1], detail=kind
+            ),
+        )
+        self._publish(run, v, w_cmd)
+
+    def _control_places(
+        self,
+        run: RunContext,
+        now_ns: int,
+        places: FleetTraffic,
+        points: np.ndarray,
+        start: np.ndarray,
+        moving: MovingPoints,
+        lost: np.ndarray,
+    ) -> None:
+        """The control tick with the fleet's places: every robot drives.
+
+        To its next place or to make way; no recovery moves (robots wait for their places).
+        """
+        aims, remaining = places.step(self.pose, self.active, self.progress_ns, now_ns)
+        # the local controller only for robots settling onto a place from off it
+        settle = None
+        if places.settling.any():
+            settle = self._local_control(aims, aims, points, start, moving, now_ns)
+        v, w = places.commands(self.pose, aims, settle, moving, self.limits)
+        self._track_progress(run, now_ns, remaining)
+        self.remaining = remaining
+        self._publish(run, np.where(lost, 0.0, v), np.where(lost, 0.0, w))
+
+    def _local_control(
+        self,
+        carrots: np.ndarray,
+        goals: np.ndarray,
+        points: np.ndarray,
+        start: np.ndarray,
+        moving: MovingPoints,
+        now_ns: int,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """DWA commands for every robot: speeds (capped near moving things), yaw rates.
+
+        Also which robots found nothing admissible ahead.
+        """
         if self.robots_layer is None:
             discs, disc_start = np.zeros((0, 3)), np.zeros(len(self.names) + 1, dtype=np.int64)
         else:
@@ -397,36 +462,7 @@ class NavigationAdapter:
         caps = speed_caps(
             moving, len(self.names), self.radius, self.limits.max_speed_mps, self.traffic
         )
-        v, w = np.minimum(result.v, caps), result.w
-        # a robot without a recent pose does not know where it is: it stops
-        moving_ok = self.active & ~self.measured.check(now_ns)
-        if self.places is not None:  # every robot drives: to make way, or onto its place
-            moving_ok = ~self.measured.check(now_ns)
-            v, w = self.places.commands(self.pose, carrots, v, w, moving, self.limits)
-        v = np.where(moving_ok, v, 0.0)
-        w = np.where(moving_ok, w, 0.0)
-        self._track_progress(run, now_ns, remaining)
-        self.remaining = remaining
-        if self.places is not None:  # robots wait for their places: no recovery moves
-            self._publish(run, v, w)
-            return
-        # halted: the controller found nothing admissible ahead, or chose to stand still
-        # (a robot in the way) while its goal is elsewhere
-        halted = result.blocked | ((np.abs(v) < HALT_MPS) & (np.abs(result.w) < HALT_RADPS))
-        # ...or has hardly moved for a while whatever it commanded (dithering nose to nose)
-        halted |= self.stalls.update(now_ns, self.pose, self.active)
-        self.recovery.apply(
-            now_ns,
-            halted,
-            moving_ok,
-            v,
-            w,
-            lambda i: self.planning.plan(run, i, now_ns, replan=True),
-            lambda i, kind: self.records.row(
-                now_ns, i, "recovery", self.goal[i, 0], self.goal[i, 1], detail=kind
-            ),
-        )
-        self._publish(run, v, w)
+        return np.minimum(result.v, caps), result.w, result.blocked
 
     def _publish(self, run: RunContext, v: np.ndarray, w: np.ndarray) -> None:
         commands = [Twist(vi, wi) for vi, wi in zip(v.tolist(), w.tolist(), strict=True)]

@@ -41,13 +41,14 @@ class Roadmap:
         xy: (m, 2) node centres in ``map`` (m).
         neighbours: (m, 4) neighbouring node along each of :data:`STEPS`, or -1.
         spacing_m: distance between neighbouring nodes (m).
-        component: (m,) connected-component label of each node.
+        component: (m,) strongly connected component of each node (derived): a robot
+            reaches every node of its own component, and only those.
     """
 
     xy: FloatArray
     neighbours: IntArray
     spacing_m: float
-    component: IntArray
+    component: IntArray = field(init=False, repr=False, compare=False)
     _tree: cKDTree = field(init=False, repr=False, compare=False)
     _graph: sparse.csr_matrix = field(init=False, repr=False, compare=False)
 
@@ -59,7 +60,9 @@ class Roadmap:
         graph = sparse.csr_matrix(
             (np.ones(int(keep.sum())), (rows[keep], cols[keep])), shape=(m, m)
         )
+        _, labels = csgraph.connected_components(graph, directed=True, connection="strong")
         object.__setattr__(self, "_graph", graph)
+        object.__setattr__(self, "component", labels.astype(np.int64))
         object.__setattr__(self, "_tree", cKDTree(self.xy if m else np.zeros((0, 2))))
 
     def __len__(self) -> int:
@@ -69,17 +72,6 @@ class Roadmap:
         """Nodes whose centres lie within ``radius_m`` of ``point`` (m), nearest first."""
         found = self._tree.query_ball_point(np.asarray(point, dtype=float), radius_m)
         return sorted(found, key=lambda k: float(np.hypot(*(self.xy[k] - point))))
-
-    def nearest(self, points: FloatArray, component: int | None = None) -> IntArray:
-        """The node nearest each of (k, 2) points (m), optionally within one component."""
-        pts = np.asarray(points, dtype=float).reshape(-1, 2)
-        if component is None:
-            _, index = self._tree.query(pts)
-            return np.asarray(index, dtype=np.int64)
-        members = np.flatnonzero(self.component == component)
-        d = np.hypot(*(pts[:, None, :] - self.xy[members][None, :, :]).transpose(2, 0, 1))
-        found: IntArray = members[np.argmin(d, axis=1)]
-        return found
 
     def nearest_k(self, points: FloatArray, k: int) -> IntArray:
         """(p, k) the ``k`` nodes nearest each of (p, 2) points (m), nearest first."""
@@ -98,10 +90,18 @@ class Roadmap:
         return out
 
 
-def _segment_clear(
+def segment_clear(
     clear: BoolArray, a: FloatArray, b: FloatArray, origin: tuple[float, float], res: float
 ) -> BoolArray:
-    """Whether every costmap cell along each segment ``a[k] -> b[k]`` is clear."""
+    """Whether every grid cell along each segment ``a[k] -> b[k]`` is clear.
+
+    Args:
+        clear: (rows, cols) cells that are clear, ``[iy, ix]``; outside the grid is not.
+        a: (k, 2) segment starts in ``map`` (m).
+        b: (k, 2) segment ends in ``map`` (m).
+        origin: ``map`` position of the lower-left corner of cell (0, 0) (m).
+        res: cell size (m); segments are sampled every half cell.
+    """
     length = float(np.max(np.hypot(*(b - a).T))) if len(a) else 0.0
     samples = max(2, int(np.ceil(length / (0.5 * res))) + 1)
     t = np.linspace(0.0, 1.0, samples)
@@ -150,7 +150,7 @@ def _grid(
         linked = other >= 0
         src = index[node_r, node_c]
         free = np.zeros(len(xy), dtype=bool)
-        free[linked] = _segment_clear(clear, xy[src[linked]], xy[other[linked]], origin, res)
+        free[linked] = segment_clear(clear, xy[src[linked]], xy[other[linked]], origin, res)
         neighbours[src[free], k] = other[free]
     return xy, neighbours
 
@@ -159,9 +159,6 @@ def one_way(
     roadmap: Roadmap, lanes: UInt8Array, origin: tuple[float, float], res: float
 ) -> Roadmap:
     """The roadmap without the steps against a one-way lane at either end of them.
-
-    Its components are then the strongly connected ones: a robot reaches every place of
-    its own component, and only those.
 
     Args:
         roadmap: a two-way roadmap.
@@ -180,13 +177,7 @@ def one_way(
         bad = linked & (lane == against[k])
         bad[linked] |= lane[other[linked]] == against[k]
         neighbours[bad, k] = -1
-    m = len(roadmap.xy)
-    rows = np.repeat(np.arange(m), 4)
-    cols = neighbours.reshape(-1)
-    keep = cols >= 0
-    graph = sparse.csr_matrix((np.ones(int(keep.sum())), (rows[keep], cols[keep])), shape=(m, m))
-    _, labels = csgraph.connected_components(graph, directed=True, connection="strong")
-    return Roadmap(roadmap.xy, neighbours, roadmap.spacing_m, labels.astype(np.int64))
+    return Roadmap(roadmap.xy, neighbours, roadmap.spacing_m)
 
 
 def build_roadmap(
@@ -227,10 +218,4 @@ def build_roadmap(
             f"a floor with room for a {spacing_m:g} m grid of robot places",
         )
     _, xy, neighbours = best
-    m = len(xy)
-    rows = np.repeat(np.arange(m), 4)
-    cols = neighbours.reshape(-1)
-    keep = cols >= 0
-    graph = sparse.csr_matrix((np.ones(int(keep.sum())), (rows[keep], cols[keep])), shape=(m, m))
-    _, labels = csgraph.connected_components(graph, directed=False)
-    return Roadmap(xy, neighbours, spacing_m, labels.astype(np.int64))
+    return Roadmap(xy, neighbours, spacing_m)
