@@ -49,6 +49,8 @@ class Hall(NamedTuple):
         placement: ``robots.placement``: ``dock`` (the preset's: every robot leaves a
             packed dock at t = 0) or ``random`` (robots spread over the floor, as in a
             hall at work).
+        traffic: ``navigation.traffic``: ``none`` (the preset's: each robot plans alone)
+            or a fleet traffic policy (``pibt``: robots move place by place).
     """
 
     robots: int
@@ -56,11 +58,14 @@ class Hall(NamedTuple):
     shelves: int
     duration_s: float
     placement: str = "dock"
+    traffic: str = "none"
 
     @property
     def key(self) -> str:
-        """Its key in the results: ``robots_<N>``, with ``_<placement>`` unless the dock."""
-        return f"robots_{self.robots}" + ("" if self.placement == "dock" else f"_{self.placement}")
+        """Its key: ``robots_<N>``, with ``_<placement>`` unless the dock, ``_<traffic>``."""
+        placement = "" if self.placement == "dock" else f"_{self.placement}"
+        traffic = "" if self.traffic == "none" else f"_{self.traffic}"
+        return f"robots_{self.robots}{placement}{traffic}"
 
 
 HALLS = (
@@ -70,11 +75,14 @@ HALLS = (
     Hall(500, 75.0, 360, 10.0),
     Hall(1000, 100.0, 600, 10.0),
     Hall(1000, 100.0, 600, 10.0, "random"),
+    Hall(1000, 100.0, 600, 10.0, "dock", "pibt"),
+    Hall(1000, 100.0, 600, 10.0, "random", "pibt"),
 )
 """18 m^2 of floor per robot up to 200 robots (the 30 m hall holds 50), 11.3 m^2 at 500 and
 10 m^2 at 1,000; 0.08 shelves per m^2 up to 200 robots, 0.064 at 500, 0.06 at 1,000. The
-1,000 robots run twice: from the preset's dock (where they gridlock at the start) and spread
-over the floor."""
+1,000 robots run from the preset's dock (where they gridlock at the start) and spread over
+the floor, each with ``navigation.traffic`` ``none`` (each robot plans alone) and ``pibt``
+(the fleet manager moves robots place by place: no A*, no DWA once on the places)."""
 
 
 class WallMarks:
@@ -129,6 +137,7 @@ def _child(hall: Hall, seed: int) -> Result:
             "scenario.seed": seed,
             "robots.count": hall.robots,
             "robots.placement": hall.placement,
+            "navigation.traffic": hall.traffic,
             "world.size_m": [hall.side_m, hall.side_m],
             "world.shelf_count": hall.shelves,
             "record.bag": "none",
@@ -143,6 +152,7 @@ def _child(hall: Hall, seed: int) -> Result:
     out: Result = {
         "robots": hall.robots,
         "placement": hall.placement,
+        "traffic": hall.traffic,
         "hall_m": [hall.side_m, hall.side_m],
         "shelves": summary["shelves"],
         "sim_time_s": hall.duration_s,
@@ -246,6 +256,8 @@ def fleet_scaling(
         rtf_1000_random_after_warmup=out.get("robots_1000_random", {}).get(
             "real_time_factor_after_warmup"
         ),
+        rtf_1000_pibt=out.get("robots_1000_pibt", {}).get("real_time_factor"),
+        rtf_1000_random_pibt=out.get("robots_1000_random_pibt", {}).get("real_time_factor"),
         peak_rss_mb_1000=rss,
         peak_rss_mb_1000_target=PEAK_RSS_TARGET_MB,
         peak_rss_mb_1000_met=None if rss is None else rss <= PEAK_RSS_TARGET_MB,

@@ -154,9 +154,10 @@ class FleetTraffic:
         from which the straight way to the goal keeps the footprint off static obstacles.
         """
         rm = self.roadmap
-        mine = np.flatnonzero(rm.component == rm.component[self.node[i]])
-        d = np.hypot(*(rm.xy[mine] - goal).T)
-        for u in mine[np.argsort(d)][: int(np.sum(d <= GOAL_REACH * rm.spacing_m))]:
+        mine = rm.component[self.node[i]]
+        near = [u for u in rm.near(goal, GOAL_REACH * rm.spacing_m) if rm.component[u] == mine]
+        near.sort(key=lambda u: (float(np.hypot(*(rm.xy[u] - goal))), u))  # ties: lowest first
+        for u in near:
             if segment_clear(self.footprint_clear, rm.xy[u][None], goal[None], *self.grid)[0]:
                 return int(u)
         return -1
@@ -167,6 +168,14 @@ class FleetTraffic:
         self.goal[i] = goal
         self.goal_node[i] = place
         self.since_ns[i] = now_ns
+
+    def way_left(self, i: int, xy: FloatArray) -> float:
+        """Robot ``i``'s way (m) from ``xy`` to its goal along the places (inf if none)."""
+        active = np.zeros(len(self.node), dtype=bool)
+        active[i] = True
+        points = np.zeros((len(self.node), 2))
+        points[i] = xy
+        return float(self._remaining(points, active)[i])
 
     def end_goal(self, i: int) -> None:
         """Robot ``i``'s goal is reached, dropped or cancelled: it settles on its place."""

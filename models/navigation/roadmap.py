@@ -16,6 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+import numba
 import numpy as np
 import numpy.typing as npt
 from scipy import sparse
@@ -50,7 +51,7 @@ class Roadmap:
     spacing_m: float
     component: IntArray = field(init=False, repr=False, compare=False)
     _tree: cKDTree = field(init=False, repr=False, compare=False)
-    _graph: sparse.csr_matrix = field(init=False, repr=False, compare=False)
+    _reverse: IntArray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         m = len(self.xy)
@@ -61,7 +62,12 @@ class Roadmap:
             (np.ones(int(keep.sum())), (rows[keep], cols[keep])), shape=(m, m)
         )
         _, labels = csgraph.connected_components(graph, directed=True, connection="strong")
-        object.__setattr__(self, "_graph", graph)
+        # the reversed edges, built once: hops *to* a goal are a search from it against them
+        reverse = np.full((m, 4), -1, dtype=np.int64)
+        for k in range(4):
+            linked = self.neighbours[:, k] >= 0
+            reverse[self.neighbours[linked, k], k] = np.flatnonzero(linked)
+        object.__setattr__(self, "_reverse", reverse)
         object.__setattr__(self, "component", labels.astype(np.int64))
         object.__setattr__(self, "_tree", cKDTree(self.xy if m else np.zeros((0, 2))))
 
@@ -83,11 +89,32 @@ class Roadmap:
 
         :data:`UNREACHABLE` where there is no way.
         """
-        d = csgraph.shortest_path(self._graph.T.tocsr(), unweighted=True, indices=goal)
         out = np.full(len(self.xy), UNREACHABLE, dtype=np.int32)
-        finite = np.isfinite(d)
-        out[finite] = d[finite].astype(np.int32)
+        _hops_to(self._reverse, goal, out)
         return out
+
+
+def _hops_to_py(reverse: IntArray, goal: int, out: Int32Array) -> None:
+    """Breadth-first search from ``goal`` along ``reverse`` ((m, 4) predecessors), into ``out``.
+
+    ``out`` holds :data:`UNREACHABLE` everywhere on entry.
+    """
+    queue = np.empty(len(out), dtype=np.int64)
+    queue[0] = goal
+    out[goal] = 0
+    head, tail = 0, 1
+    while head < tail:
+        u = queue[head]
+        head += 1
+        for k in range(4):
+            v = reverse[u, k]
+            if v >= 0 and out[v] == UNREACHABLE:
+                out[v] = out[u] + 1
+                queue[tail] = v
+                tail += 1
+
+
+_hops_to: Any = numba.njit(cache=True)(_hops_to_py)
 
 
 def segment_clear(

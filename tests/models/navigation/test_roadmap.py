@@ -2,11 +2,14 @@
 
 import numpy as np
 import pytest
-from scipy import ndimage
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy import ndimage, sparse
+from scipy.sparse import csgraph
 
 from models.errors import ModelError
 from models.navigation.lanes import EAST, TWO_WAY
-from models.navigation.roadmap import STEPS, UNREACHABLE, build_roadmap, one_way
+from models.navigation.roadmap import STEPS, UNREACHABLE, Roadmap, build_roadmap, one_way
 
 RES = 0.1
 CLEARANCE = 0.43  # a 0.33 m robot and a 0.1 m margin
@@ -82,3 +85,25 @@ def test_one_way_aisles_lose_their_backward_steps_and_hops_follow_the_directions
     assert hops_west[east] > straight  # back round the racks
     assert hops_west[east] != UNREACHABLE
     assert len(set(directed.component.tolist())) == 1  # still one strongly connected piece
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    keep=st.floats(0.3, 1.0),
+)
+def test_hops_to_a_place_are_the_fewest_steps_along_the_edges_directions(seed, keep):
+    """Against scipy's breadth-first shortest paths on the same directed graph."""
+    rng = np.random.default_rng(seed)
+    roadmap = build_roadmap(_distance(_hall_with_a_box()), (0.0, 0.0), RES, 0.8, CLEARANCE)
+    neighbours = np.where(rng.random(roadmap.neighbours.shape) < keep, roadmap.neighbours, -1)
+    directed = Roadmap(roadmap.xy, neighbours, roadmap.spacing_m)
+    m = len(directed)
+    rows, cols = np.nonzero(neighbours >= 0)
+    graph = sparse.csr_matrix((np.ones(len(rows)), (rows, neighbours[rows, cols])), shape=(m, m))
+    goal = int(rng.integers(m))
+    expected = csgraph.shortest_path(graph.T.tocsr(), unweighted=True, indices=goal)
+    hops = directed.hops_to(goal)
+    reached = np.isfinite(expected)
+    assert (hops[~reached] == UNREACHABLE).all()
+    np.testing.assert_array_equal(hops[reached], expected[reached].astype(np.int32))
