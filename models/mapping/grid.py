@@ -333,7 +333,13 @@ def merged(maps: list[LogOddsMap]) -> OccupancyGrid:
     """
     first = maps[0]
     p = first.params
-    total = np.clip(np.sum([m.logodds for m in maps], axis=0), p.clamp_min, p.clamp_max)
+    # added in place one map after the other: the same float32 sums, in the same order, as
+    # np.sum over a stack of the maps (axis 0), without building the stack (50 maps of
+    # 648 x 648 cells: 84 MB copied, 53 ms, against 9 ms)
+    total = first.logodds.copy()
+    for m in maps[1:]:
+        total += m.logodds
+    total = np.clip(total, p.clamp_min, p.clamp_max)
     cells = np.full(total.shape, UNKNOWN, dtype=np.int8)
     cells[total <= p.free] = FREE
     cells[total >= p.occupied] = OCCUPIED

@@ -4,7 +4,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from models.mapping.grid import COARSE, LogOddsMap, LogOddsParams, MapGeometry
+from models.mapping.grid import COARSE, LogOddsMap, LogOddsParams, MapGeometry, merged
 from models.mapping.kernels import rebuild_scores
 from models.occupancy import FREE, OCCUPIED, UNKNOWN
 from tests.models.mapping.conftest import GEOMETRY, ROOM, Lidar, integrate, room_map
@@ -137,3 +137,26 @@ def test_the_default_update_rule_is_octomaps_with_a_weak_miss():
     assert math.isclose(p.hit, math.log(0.7 / 0.3))
     assert math.isclose(p.miss, math.log(0.48 / 0.52))
     assert math.isclose(p.occupied, math.log(0.65 / 0.35))
+
+
+def test_maps_fused_one_after_the_other_equal_the_sum_of_their_stack_bit_for_bit():
+    """float32 sums depend on their order: the fleet map keeps that of np.sum over axis 0."""
+    rng = np.random.default_rng(7)
+    geometry = MapGeometry.covering((-0.2, -0.2, 12.2, 8.2), 0.05, 1.0)
+    maps = [LogOddsMap(geometry) for _ in range(12)]
+    for grid in maps:
+        values = rng.normal(0.0, 2.0, grid.logodds.shape).astype(np.float32)
+        grid.logodds[:] = np.where(rng.random(values.shape) < 0.5, values, 0.0)
+    p = maps[0].params
+    # one cell whose class depends on the order: (free + 1e8) - 1e8 is 0 in float32
+    maps[0].logodds[5, 5], maps[1].logodds[5, 5], maps[2].logodds[5, 5] = p.free - 1.0, 1e8, -1e8
+    for grid in maps[3:]:
+        grid.logodds[5, 5] = 0.0
+    total = np.clip(np.sum([m.logodds for m in maps], axis=0), p.clamp_min, p.clamp_max)
+    expected = np.full(total.shape, UNKNOWN, dtype=np.int8)
+    expected[total <= p.free] = FREE
+    expected[total >= p.occupied] = OCCUPIED
+    fused = merged(maps).data
+    assert np.array_equal(fused, expected)
+    assert (fused == FREE).any() and (fused == OCCUPIED).any() and (fused == UNKNOWN).any()
+    assert fused[5, 5] == UNKNOWN  # added the other way round it would be free
