@@ -31,7 +31,7 @@ import numpy.typing as npt
 
 from models.arrays import FloatArray
 from models.errors import ModelError
-from models.mapping.kernels import apply, rebuild_scores, refresh_scores, traverse
+from models.mapping.kernels import apply, classify, rebuild_scores, refresh_scores, traverse
 from models.occupancy import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 
 COARSE = 4
@@ -308,9 +308,10 @@ class LogOddsMap:
     def occupancy(self) -> npt.NDArray[np.int8]:
         """Trinary cells: 100 occupied, 0 free, -1 unknown (``nav_msgs/OccupancyGrid``)."""
         p = self.params
-        cells = np.full(self.logodds.shape, UNKNOWN, dtype=np.int8)
-        cells[self.logodds <= p.free] = FREE
-        cells[self.logodds >= p.occupied] = OCCUPIED
+        cells = np.empty(self.logodds.shape, dtype=np.int8)
+        # compared in numpy's type for the array and the threshold (float32 for a float)
+        kind = np.result_type(self.logodds, p.free, p.occupied).type
+        classify(self.logodds, kind(p.free), kind(p.occupied), cells)
         return cells
 
     def occupancy_grid(self) -> OccupancyGrid:

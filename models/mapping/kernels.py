@@ -12,6 +12,8 @@ from typing import Any
 
 import numba
 
+from models.occupancy import FREE, OCCUPIED, UNKNOWN
+
 
 def _traverse_py(
     stamp: Any,
@@ -270,7 +272,17 @@ def _rebuild_scores_py(
     return count
 
 
+def _classify_py(logodds: Any, free: Any, occupied: Any, cells: Any) -> None:
+    """Trinary cells of a log-odds grid: 100 from ``occupied`` on, 0 up to ``free``, else -1."""
+    height, width = logodds.shape
+    for iy in range(height):
+        for ix in range(width):
+            v = logodds[iy, ix]
+            cells[iy, ix] = OCCUPIED if v >= occupied else (FREE if v <= free else UNKNOWN)
+
+
 traverse: Any = numba.njit(cache=True)(_traverse_py)
+classify: Any = numba.njit(cache=True)(_classify_py)
 apply: Any = numba.njit(cache=True)(_apply_py)
 _recompute_score: Any = numba.njit(cache=True)(_recompute_score_py)
 _refresh_coarse: Any = numba.njit(cache=True)(_refresh_coarse_py)

@@ -1,6 +1,7 @@
 import math
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -160,3 +161,26 @@ def test_maps_fused_one_after_the_other_equal_the_sum_of_their_stack_bit_for_bit
     assert np.array_equal(fused, expected)
     assert (fused == FREE).any() and (fused == OCCUPIED).any() and (fused == UNKNOWN).any()
     assert fused[5, 5] == UNKNOWN  # added the other way round it would be free
+
+
+@pytest.mark.parametrize("wide", [False, True])
+def test_trinary_cells_equal_those_of_numpys_comparisons_at_and_around_the_thresholds(wide):
+    """numpy compares float32 log-odds with a float threshold in float32, with a float64
+    one in float64; the compiled classification must do the same, at the edges too."""
+    geometry = MapGeometry.covering((0.0, 0.0, 2.0, 2.0), 0.05, 0.0)
+    kind = np.float64 if wide else float
+    # float32(0.7) < 0.7: the cell at float32(0.7) is occupied in float64 only
+    params = LogOddsParams(occupied=kind(0.7), free=kind(-0.7))
+    grid = LogOddsMap(geometry, params)
+    edges = []
+    for t in (params.free, params.occupied):
+        for v in (np.float32(t), np.float64(t)):
+            edges += [np.nextafter(np.float32(v), np.float32(-9)), np.float32(v)]
+            edges += [np.nextafter(np.float32(v), np.float32(9))]
+    values = np.random.default_rng(2).normal(0.0, 1.0, grid.logodds.size).astype(np.float32)
+    values[: len(edges)] = edges
+    grid.logodds[:] = values.reshape(grid.logodds.shape)
+    expected = np.full(grid.logodds.shape, UNKNOWN, dtype=np.int8)
+    expected[grid.logodds <= params.free] = FREE
+    expected[grid.logodds >= params.occupied] = OCCUPIED
+    assert np.array_equal(grid.occupancy(), expected)
