@@ -197,7 +197,9 @@ def _refresh_scores_py(
     height, width = logodds.shape
     r = kernel.shape[0] // 2
     net = 0
-    # cleared cells: mark the windows they influenced (another occupied cell may remain)
+    # cleared cells: mark the cells whose score may have come from them. A cell scoring
+    # more than a cleared cell gave it keeps its score: the occupied cell that gave it is
+    # still there (were it cleared too, the cell would score no more than it gave)
     for f in flips:
         iy, ix = f // width, f % width
         if logodds[iy, ix] >= occ:
@@ -206,7 +208,9 @@ def _refresh_scores_py(
         net -= 1
         for y in range(max(0, iy - r), min(height, iy + r + 1)):
             for x in range(max(0, ix - r), min(width, ix + r + 1)):
-                dirty[y, x] |= 1
+                given = kernel[y - iy + r, x - ix + r]
+                if given > 0 and score[y, x] <= given:
+                    dirty[y, x] |= 1
     for f in flips:
         iy, ix = f // width, f % width
         if logodds[iy, ix] >= occ:

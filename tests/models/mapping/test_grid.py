@@ -184,3 +184,22 @@ def test_trinary_cells_equal_those_of_numpys_comparisons_at_and_around_the_thres
     expected[grid.logodds <= params.free] = FREE
     expected[grid.logodds >= params.occupied] = OCCUPIED
     assert np.array_equal(grid.occupancy(), expected)
+
+
+@pytest.mark.parametrize("cleared", [[(20, 20)], [(20, 20), (20, 21)], [(20, 21), (22, 20)]])
+def test_cells_cleared_next_to_equal_obstacles_leave_the_scores_rebuilt_from_scratch(cleared):
+    """Scores tied between neighbouring obstacles: clearing one keeps the other's, clearing
+    both lowers them; only cells scoring no more than a cleared cell gave are recomputed."""
+    geometry = MapGeometry.covering((0.0, 0.0, 3.0, 3.0), 0.05, 0.0)
+    grid = LogOddsMap(geometry)
+    high = grid.params.clamp_max
+    block = np.zeros((5, 5), dtype=np.float32)
+    block[[0, 0, 2], [0, 1, 0]] = high  # cells (20, 20), (20, 21), (22, 20)
+    grid.add_logodds(20, 20, block)
+    for iy, ix in cleared:
+        clear = np.full((1, 1), -2 * high, dtype=np.float32)
+        assert grid.add_logodds(iy, ix, clear) == 1
+    score, coarse, count = _rebuilt(grid)
+    assert np.array_equal(grid.score, score)
+    assert np.array_equal(grid.coarse, coarse)
+    assert grid.occupied_cells == count == 3 - len(cleared)
