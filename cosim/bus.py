@@ -24,7 +24,7 @@ import simpy
 
 from cosim.hosts import HostId
 from cosim.kernel import Kernel, Stage
-from cosim.link import DeliveryStatus, IdealLink, Link
+from cosim.link import DeliveryStatus, IdealLink, Link, Transfer
 from cosim.messages import Message
 
 
@@ -92,6 +92,12 @@ class BusTap(Protocol):
         status: DeliveryStatus,
     ) -> None:
         """Record one message towards one destination host."""
+        ...
+
+    def on_transmission(
+        self, t_sent_ns: int, src: HostId, topic: str, nbytes: int, transfers: Sequence[Transfer]
+    ) -> None:
+        """Record one transmission's transfers, in order: :meth:`on_transfer` for each."""
         ...
 
 
@@ -231,13 +237,11 @@ class Bus:
         order. The order of everything is as with an event each: events of one instant and
         stage run in scheduling order, and these were scheduled back to back.
         """
-        tap = self.tap
+        transfers = self.link.transmit(t_sent_ns, src, remote, nbytes, topic)
+        if self.tap is not None:
+            self.tap.on_transmission(t_sent_ns, src, topic, nbytes, transfers)
         arrivals: dict[int, list[HostId]] = {}
-        for transfer in self.link.transmit(t_sent_ns, src, remote, nbytes, topic):
-            if tap is not None:
-                tap.on_transfer(
-                    t_sent_ns, transfer.t_recv_ns, src, transfer.dst, topic, nbytes, transfer.status
-                )
+        for transfer in transfers:
             if transfer.status is not DeliveryStatus.DELIVERED or transfer.t_recv_ns is None:
                 continue
             if transfer.t_recv_ns < t_sent_ns:

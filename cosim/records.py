@@ -9,6 +9,7 @@ exported both as exact ``*_ns`` columns and as ``*_s`` seconds columns.
 from __future__ import annotations
 
 import math
+from array import array
 from collections.abc import Iterable, Mapping, Sequence
 from typing import Any, Protocol
 
@@ -17,7 +18,7 @@ import numpy.typing as npt
 import pandas as pd
 
 from cosim.hosts import HostId
-from cosim.link import DeliveryStatus
+from cosim.link import DeliveryStatus, Transfer
 from cosim.timebase import NS_PER_S
 
 
@@ -150,8 +151,9 @@ _FLUSH_ROWS = 65_536
 class Recorder:
     """Collects the run's tables: messages (from the bus tap), events, and adapter tables.
 
-    Message rows are appended as tuples (cheap on the hot path) and packed into NumPy
-    columns every 65,536 rows (bounded memory).
+    Message rows are appended column by column (a broadcast's rows in one call, see
+    :meth:`on_transmission`) and packed into NumPy columns every 65,536 rows (bounded
+    memory).
 
     Args:
         record_messages: keep a row per message and destination host.
@@ -162,7 +164,14 @@ class Recorder:
         self._hosts = _Interner()
         self._topics = _Interner()
         self._statuses = _Interner()
-        self._pending: list[tuple[int, int, str, str, str, int, str]] = []
+        # the rows not packed yet, by column
+        self._t_sent = array("q")
+        self._t_recv = array("q")
+        self._src: list[str] = []
+        self._dst: list[str] = []
+        self._topic: list[str] = []
+        self._bytes = array("q")
+        self._status: list[str] = []
         self._chunks: list[dict[str, npt.NDArray[Any]]] = []
         self._events = Table(("t_ns", "source", "kind", "detail"))
         self.tables: dict[str, Table] = {}
@@ -191,30 +200,78 @@ class Recorder:
             self.network_bytes += nbytes
         if not self.record_messages:
             return
-        pending = self._pending
-        pending.append(
-            (t_sent_ns, -1 if t_recv_ns is None else t_recv_ns, src, dst, topic, nbytes, status)
-        )
-        if len(pending) >= _FLUSH_ROWS:
+        self._t_sent.append(t_sent_ns)
+        self._t_recv.append(-1 if t_recv_ns is None else t_recv_ns)
+        self._src.append(src)
+        self._dst.append(dst)
+        self._topic.append(topic)
+        self._bytes.append(nbytes)
+        self._status.append(status)
+        if len(self._src) >= _FLUSH_ROWS:
             self._flush()
 
-    def _flush(self) -> None:
-        if not self._pending:
+    def on_transmission(
+        self, t_sent_ns: int, src: HostId, topic: str, nbytes: int, transfers: Sequence[Transfer]
+    ) -> None:
+        """Record one transmission towards several hosts: :meth:`on_transfer` for each, in order.
+
+        The same rows, counts and tables, appended a column at a time: a broadcast to 49
+        robots is one call instead of 49.
+        """
+        n = len(transfers)
+        if not n:
             return
-        t_sent, t_recv, src, dst, topic, nbytes, status = zip(*self._pending, strict=True)
-        hosts, topics, statuses = self._hosts, self._topics, self._statuses
-        self._chunks.append(
-            {
-                "t_sent": np.array(t_sent, dtype=np.int64),
-                "t_recv": np.array(t_recv, dtype=np.int64),
-                "src": hosts.codes_of(src),
-                "dst": hosts.codes_of(dst),
-                "topic": topics.codes_of(topic),
-                "bytes": np.array(nbytes, dtype=np.int64),
-                "status": statuses.codes_of(status),
-            }
-        )
-        self._pending = []
+        statuses = [t.status for t in transfers]
+        dsts = [t.dst for t in transfers]
+        counts = self.counts
+        for status in statuses:
+            counts[status] += 1
+        others = n - dsts.count(src)
+        self.network_messages += others
+        self.network_bytes += others * nbytes
+        if not self.record_messages:
+            return
+        self._t_sent.extend([t_sent_ns] * n)
+        self._t_recv.extend([-1 if t.t_recv_ns is None else t.t_recv_ns for t in transfers])
+        self._src.extend([src] * n)
+        self._dst.extend(dsts)
+        self._topic.extend([topic] * n)
+        self._bytes.extend([nbytes] * n)
+        self._status.extend(statuses)
+        if len(self._src) >= _FLUSH_ROWS:
+            self._flush()
+
+    def _flush(self, *, rest: bool = False) -> None:
+        """Pack the pending rows in chunks of 65,536 rows, and with ``rest`` the rest too.
+
+        The chunks are those of rows packed one at a time as they come, so that hosts,
+        topics and statuses get their category codes in the same order (per chunk:
+        sources first, then destinations).
+        """
+        while len(self._src) >= (1 if rest else _FLUSH_ROWS):
+            take = min(len(self._src), _FLUSH_ROWS)
+            hosts, topics, statuses = self._hosts, self._topics, self._statuses
+            self._chunks.append(
+                {
+                    "t_sent": np.array(self._t_sent[:take], dtype=np.int64),
+                    "t_recv": np.array(self._t_recv[:take], dtype=np.int64),
+                    "src": hosts.codes_of(self._src[:take]),
+                    "dst": hosts.codes_of(self._dst[:take]),
+                    "topic": topics.codes_of(self._topic[:take]),
+                    "bytes": np.array(self._bytes[:take], dtype=np.int64),
+                    "status": statuses.codes_of(self._status[:take]),
+                }
+            )
+            for column in (
+                self._t_sent,
+                self._t_recv,
+                self._src,
+                self._dst,
+                self._topic,
+                self._bytes,
+                self._status,
+            ):
+                del column[:take]
 
     # -- events and adapter tables ---------------------------------------------------
     def event(self, t_ns: int, source: str, kind: str, detail: str = "") -> None:
@@ -264,7 +321,7 @@ class Recorder:
     # -- export ----------------------------------------------------------------------
     def messages_frame(self) -> pd.DataFrame:
         """The messages table: one row per message and destination host."""
-        self._flush()
+        self._flush(rest=True)
 
         def column(name: str, dtype: type) -> npt.NDArray[Any]:
             parts = [chunk[name] for chunk in self._chunks]

@@ -9,8 +9,9 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
+import numba
 import numpy as np
 import numpy.typing as npt
 
@@ -207,12 +208,11 @@ def resample(grid: OccupancyGrid, resolution_m: float) -> OccupancyGrid:
         raise ModelError("resolution_m", resolution_m, "a finite cell size > 0 (m)")
     rows, cols = grid.data.shape
     ratio = grid.resolution_m / resolution_m
-    width = max(1, math.ceil(cols * ratio - _SNAP_CELLS))
-    height = max(1, math.ceil(rows * ratio - _SNAP_CELLS))
+    height, width = _resampled_shape(grid.data.shape, ratio)
     # rank: occupied 2 > free 1 > unknown 0; the highest rank of a cell's sources wins
     rank = np.where(grid.data >= OCCUPIED, 2, np.where(grid.data == FREE, 1, 0)).astype(np.int8)
-    k = round(1.0 / ratio)
-    if k >= 1 and abs(k * ratio - 1.0) < 1e-9:  # whole blocks of k x k cells: one reshape
+    k = _block(ratio)
+    if k is not None:  # whole blocks of k x k cells: one reshape
         padded = np.zeros((height * k, width * k), dtype=np.int8)
         padded[:rows, :cols] = rank
         best = padded[0::k, 0::k].copy()
@@ -226,3 +226,54 @@ def resample(grid: OccupancyGrid, resolution_m: float) -> OccupancyGrid:
         np.maximum.at(best, (row_of[:, None], col_of[None, :]), rank)
     data = np.select([best == 2, best == 1], [OCCUPIED, FREE], UNKNOWN).astype(np.int8)
     return OccupancyGrid(resolution_m, grid.origin_xy_m, data)
+
+
+def _resampled_shape(shape: tuple[int, ...], ratio: float) -> tuple[int, int]:
+    """Rows and columns of a grid of ``shape`` resampled by ``ratio`` (old / new cell size)."""
+    rows, cols = shape
+    return (
+        max(1, math.ceil(rows * ratio - _SNAP_CELLS)),
+        max(1, math.ceil(cols * ratio - _SNAP_CELLS)),
+    )
+
+
+def _block(ratio: float) -> int | None:
+    """The block edge k (cells) when a new cell is exactly k x k old ones, else None."""
+    k = round(1.0 / ratio)
+    return k if k >= 1 and abs(k * ratio - 1.0) < 1e-9 else None
+
+
+def resampled_obstacles(
+    data: Int8Array, from_resolution_m: float, resolution_m: float
+) -> npt.NDArray[np.bool_] | None:
+    """The occupied cells of :func:`resample` of a grid's cells, without resampling it.
+
+    A new cell is occupied when any old cell whose centre it holds is (free and unknown
+    cells are not told apart). Only when a new cell is exactly k x k old cells, else None
+    (then call :func:`resample`).
+
+    Args:
+        data: (rows, cols) int8 cell values of the grid, any layout.
+        from_resolution_m: the grid's cell size (m/cell).
+        resolution_m: the new cell size (m/cell).
+    """
+    ratio = from_resolution_m / resolution_m
+    k = _block(ratio)
+    if k is None:
+        return None
+    height, width = _resampled_shape(data.shape, ratio)
+    occupied = np.zeros((height, width), dtype=np.bool_)
+    _occupied_blocks(np.ascontiguousarray(data), k, occupied)
+    return occupied
+
+
+def _occupied_blocks_py(data: Int8Array, k: int, occupied: npt.NDArray[np.bool_]) -> None:
+    rows = min(data.shape[0], occupied.shape[0] * k)
+    cols = min(data.shape[1], occupied.shape[1] * k)
+    for r in range(rows):
+        for c in range(cols):
+            if data[r, c] >= OCCUPIED:
+                occupied[r // k, c // k] = True
+
+
+_occupied_blocks: Any = numba.njit(cache=True)(_occupied_blocks_py)

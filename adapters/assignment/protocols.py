@@ -15,7 +15,7 @@ import numpy as np
 
 from cosim.messages import AuctionBids, Message, SimplexBasis
 from models.assignment.cbaa import CbaaAgent, scores_from_cost
-from models.assignment.dsimplex import agent_for
+from models.assignment.dsimplex import SharedBasis, agent_for
 from models.assignment.greedy import nearest_free
 from models.assignment.problem import AssignmentProblem, Column, ColumnKind
 
@@ -24,25 +24,26 @@ _KINDS = {int(kind): kind for kind in ColumnKind}
 
 
 class BasisDecoder:
-    """Wire bases turned into :class:`Column` lists, once per sender and basis.
+    """Wire bases turned into :class:`Column` tuples, once per sender and basis.
 
     A robot's basis message is delivered to each of its neighbours every round, and a
     sender keeps its wire tuple between basis changes: decoding it in every receiver every
     round built ~2.5 million columns a simulated second in ``fleet50`` (50 robots, 50 tasks,
     complete graph; 5 of 9 s of wall time). One decoder is shared by the fleet's protocols:
     a sender's tuple is decoded when it is a new object, and every receiver gets the same
-    list (never modified) until it changes.
+    :class:`~models.assignment.dsimplex.SharedBasis` (a tuple, with its set of columns)
+    until it changes.
     """
 
     def __init__(self) -> None:
-        self._last: dict[str, tuple[tuple[tuple[int, int, int, float], ...], list[Column]]] = {}
+        self._last: dict[str, tuple[tuple[tuple[int, int, int, float], ...], SharedBasis]] = {}
 
-    def decode(self, message: SimplexBasis) -> list[Column]:
-        """The columns of ``message``'s basis (shared: do not modify)."""
+    def decode(self, message: SimplexBasis) -> SharedBasis:
+        """The columns of ``message``'s basis (shared, immutable, with their set)."""
         known = self._last.get(message.robot)
         if known is not None and known[0] is message.columns:
             return known[1]
-        columns = [Column(_KINDS[k], r, t, c) for k, r, t, c in message.columns]
+        columns = SharedBasis(Column(_KINDS[k], r, t, c) for k, r, t, c in message.columns)
         self._last[message.robot] = (message.columns, columns)
         return columns
 

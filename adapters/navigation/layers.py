@@ -17,7 +17,14 @@ import numpy.typing as npt
 from cosim.messages import OccupancyGrid as GridMessage
 from models.navigation.costmap import CostmapParams, StaticCostmap
 from models.navigation.lanes import TWO_WAY, aisle_lanes
-from models.occupancy import FREE, OCCUPIED, UNKNOWN, OccupancyGrid, resample
+from models.occupancy import (
+    FREE,
+    OCCUPIED,
+    UNKNOWN,
+    OccupancyGrid,
+    resample,
+    resampled_obstacles,
+)
 
 
 class StaticLayer:
@@ -71,10 +78,17 @@ class StaticLayers:
     def update(self, robot: int, message: GridMessage) -> None:
         """A robot's new map: resample, make unknown traversable, inflate, restack."""
         cells = np.frombuffer(message.data, dtype=np.int8).reshape(message.height, message.width)
-        grid = OccupancyGrid(message.resolution_m, (message.origin_x_m, message.origin_y_m), cells)
-        layer = StaticCostmap.from_grid(
-            _traversable(resample(grid, self.resolution_m)), self.params
-        )
+        origin = (message.origin_x_m, message.origin_y_m)
+        # with unknown cells traversable only the obstacles count: when the costmap's cells
+        # are whole blocks of the map's, they are found without resampling the map
+        obstacles = resampled_obstacles(cells, message.resolution_m, self.resolution_m)
+        if obstacles is not None:
+            layer = StaticCostmap.from_obstacles(obstacles, self.resolution_m, origin, self.params)
+        else:
+            grid = OccupancyGrid(message.resolution_m, origin, cells)
+            layer = StaticCostmap.from_grid(
+                _traversable(resample(grid, self.resolution_m)), self.params
+            )
         if layer.cost.shape != self.layers[robot].cost.shape:
             raise ValueError(
                 f"map of {message.width} x {message.height} cells does not cover the same "

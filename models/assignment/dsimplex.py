@@ -19,9 +19,9 @@ tests and benchmarks.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Iterable, Sequence
-from itertools import chain
 from typing import NamedTuple
 
 import numpy as np
@@ -37,6 +37,20 @@ from models.assignment.problem import (
 from models.assignment.simplex import lex_simplex
 from models.errors import ModelError
 from models.network.topology import hops_from
+
+
+class SharedBasis(tuple[Column, ...]):
+    """A basis as a neighbour sent it, merged by every agent that received it.
+
+    A tuple of its m columns that also keeps their set (:attr:`column_set`), built on
+    first use: 49 agents merging one basis hash its columns once instead of 49 times.
+    Do not build one from columns that may change (tuples of tuples never do).
+    """
+
+    @functools.cached_property
+    def column_set(self) -> frozenset[Column]:
+        """The columns as a set."""
+        return frozenset(self)
 
 
 class SimplexAgent:
@@ -77,9 +91,10 @@ class SimplexAgent:
         self.diameter_bound = diameter_bound
         self.epoch = epoch
         self._known = tuple(sorted(set(own_columns).union(unserved_columns(shape, unserved_cost))))
+        self._known_set = frozenset(self._known)
         self._basis = identity_basis(shape, unserved_cost)
         self._inverse = np.eye(shape.rows)
-        self._candidates: dict[Column, None] = {}
+        self._candidates: set[Column] = set()
         # received bases (by identity, held so that ids stay theirs) whose columns are all
         # candidates: a neighbour resends the same basis object until it changes
         self._merged: dict[int, Sequence[Column]] = {}
@@ -136,8 +151,13 @@ class SimplexAgent:
             self.pivots = 0
             self.unchanged += 1
             return False
-        columns = dict.fromkeys(chain(self._known, self._basis, *received))
-        self.solved = not columns.keys() <= self._candidates.keys()
+        # a set of sets, whose columns keep the hashes they were stored with: a received
+        # basis's own set is built once for every agent that merges it (SharedBasis)
+        columns = set(self._known_set)
+        columns.update(self._basis)
+        for basis in received:
+            columns.update(basis.column_set if isinstance(basis, SharedBasis) else basis)
+        self.solved = not columns <= self._candidates
         if not self.solved:
             merged.update((id(b), b) for b in received)
             self.pivots = 0

@@ -31,7 +31,7 @@ import numpy.typing as npt
 
 from models.arrays import FloatArray
 from models.errors import ModelError
-from models.mapping.kernels import apply, rebuild_scores, refresh_scores, traverse
+from models.mapping.kernels import apply, classify, rebuild_scores, refresh_scores, traverse
 from models.occupancy import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 
 COARSE = 4
@@ -308,9 +308,10 @@ class LogOddsMap:
     def occupancy(self) -> npt.NDArray[np.int8]:
         """Trinary cells: 100 occupied, 0 free, -1 unknown (``nav_msgs/OccupancyGrid``)."""
         p = self.params
-        cells = np.full(self.logodds.shape, UNKNOWN, dtype=np.int8)
-        cells[self.logodds <= p.free] = FREE
-        cells[self.logodds >= p.occupied] = OCCUPIED
+        cells = np.empty(self.logodds.shape, dtype=np.int8)
+        # compared in numpy's type for the array and the threshold (float32 for a float)
+        kind = np.result_type(self.logodds, p.free, p.occupied).type
+        classify(self.logodds, kind(p.free), kind(p.occupied), cells)
         return cells
 
     def occupancy_grid(self) -> OccupancyGrid:
@@ -333,7 +334,13 @@ def merged(maps: list[LogOddsMap]) -> OccupancyGrid:
     """
     first = maps[0]
     p = first.params
-    total = np.clip(np.sum([m.logodds for m in maps], axis=0), p.clamp_min, p.clamp_max)
+    # added in place one map after the other: the same float32 sums, in the same order, as
+    # np.sum over a stack of the maps (axis 0), without building the stack (50 maps of
+    # 648 x 648 cells: 84 MB copied, 53 ms, against 9 ms)
+    total = first.logodds.copy()
+    for m in maps[1:]:
+        total += m.logodds
+    total = np.clip(total, p.clamp_min, p.clamp_max)
     cells = np.full(total.shape, UNKNOWN, dtype=np.int8)
     cells[total <= p.free] = FREE
     cells[total >= p.occupied] = OCCUPIED

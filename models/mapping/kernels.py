@@ -12,6 +12,8 @@ from typing import Any
 
 import numba
 
+from models.occupancy import FREE, OCCUPIED, UNKNOWN
+
 
 def _traverse_py(
     stamp: Any,
@@ -195,7 +197,9 @@ def _refresh_scores_py(
     height, width = logodds.shape
     r = kernel.shape[0] // 2
     net = 0
-    # cleared cells: mark the windows they influenced (another occupied cell may remain)
+    # cleared cells: mark the cells whose score may have come from them. A cell scoring
+    # more than a cleared cell gave it keeps its score: the occupied cell that gave it is
+    # still there (were it cleared too, the cell would score no more than it gave)
     for f in flips:
         iy, ix = f // width, f % width
         if logodds[iy, ix] >= occ:
@@ -204,7 +208,9 @@ def _refresh_scores_py(
         net -= 1
         for y in range(max(0, iy - r), min(height, iy + r + 1)):
             for x in range(max(0, ix - r), min(width, ix + r + 1)):
-                dirty[y, x] |= 1
+                given = kernel[y - iy + r, x - ix + r]
+                if given > 0 and score[y, x] <= given:
+                    dirty[y, x] |= 1
     for f in flips:
         iy, ix = f // width, f % width
         if logodds[iy, ix] >= occ:
@@ -270,7 +276,17 @@ def _rebuild_scores_py(
     return count
 
 
+def _classify_py(logodds: Any, free: Any, occupied: Any, cells: Any) -> None:
+    """Trinary cells of a log-odds grid: 100 from ``occupied`` on, 0 up to ``free``, else -1."""
+    height, width = logodds.shape
+    for iy in range(height):
+        for ix in range(width):
+            v = logodds[iy, ix]
+            cells[iy, ix] = OCCUPIED if v >= occupied else (FREE if v <= free else UNKNOWN)
+
+
 traverse: Any = numba.njit(cache=True)(_traverse_py)
+classify: Any = numba.njit(cache=True)(_classify_py)
 apply: Any = numba.njit(cache=True)(_apply_py)
 _recompute_score: Any = numba.njit(cache=True)(_recompute_score_py)
 _refresh_coarse: Any = numba.njit(cache=True)(_refresh_coarse_py)

@@ -273,26 +273,38 @@ def _search_py(
         for i in range(n_pts):
             bx[a, i] = math.floor((x0 + ca * px[i] - sa * py[i] - ox) / res)
             by[a, i] = math.floor((y0 + sa * px[i] + ca * py[i] - oy) / res)
-    # the bound of every (rotation, block): sum of coarse scores at the block's corner
+    # the bound of every (rotation, block): sum of coarse scores at the block's corner,
+    # point by point (the integer sums do not depend on the order): a point's samples lie
+    # close together, and a point whose blocks all lie on the grid needs no checks
     n_nodes = n_rot * blocks * blocks
     bounds = np.empty(n_nodes, dtype=np.float64)
+    sums = np.zeros(blocks * blocks, dtype=np.int64)
+    reach = (blocks - 1) * c
     for a in range(n_rot):
-        for bj in range(blocks):
-            for bi in range(blocks):
-                kx = -n_lin + bi * c
-                ky = -n_lin + bj * c
-                total = 0
-                for i in range(n_pts):
-                    cx = bx[a, i] + kx
-                    cy = by[a, i] + ky
-                    # a window hanging over the low edge is bounded by the edge's window
+        sums[:] = 0
+        for i in range(n_pts):
+            y0i = by[a, i] - n_lin
+            x0i = bx[a, i] - n_lin
+            if y0i >= 0 and x0i >= 0 and y0i + reach < height and x0i + reach < width:
+                for bj in range(blocks):
+                    for bi in range(blocks):
+                        sums[bj * blocks + bi] += int(coarse[y0i + bj * c, x0i + bi * c])
+                continue
+            for bj in range(blocks):
+                cy = y0i + bj * c
+                # a window hanging over the low edge is bounded by the edge's window
+                if -c < cy < 0:
+                    cy = 0
+                if cy < 0 or cy >= height:
+                    continue
+                for bi in range(blocks):
+                    cx = x0i + bi * c
                     if -c < cx < 0:
                         cx = 0
-                    if -c < cy < 0:
-                        cy = 0
-                    if 0 <= cx < width and 0 <= cy < height:
-                        total += int(coarse[cy, cx])
-                bounds[(a * blocks + bj) * blocks + bi] = total / (255.0 * n_pts)
+                    if 0 <= cx < width:
+                        sums[bj * blocks + bi] += int(coarse[cy, cx])
+        for k in range(blocks * blocks):
+            bounds[a * blocks * blocks + k] = sums[k] / (255.0 * n_pts)
     order = np.argsort(-bounds)
     # the prior itself (no translation, middle rotation) is the first candidate: another
     # must beat it by ``margin`` to be chosen, so equal scores keep the odometry
@@ -308,6 +320,7 @@ def _search_py(
     evaluated = 1
     w_lin = float(n_lin) * n_lin
     w_rot = float(n_rot // 2) * (n_rot // 2) if n_rot > 1 else 1.0
+    block = np.zeros((c, c), dtype=np.int64)
     for node in order:
         if bounds[node] <= best:
             break
@@ -315,17 +328,35 @@ def _search_py(
         bj = (node // blocks) % blocks
         bi = node % blocks
         da = a - n_rot // 2
-        for ky in range(-n_lin + bj * c, min(-n_lin + bj * c + c, n_lin + 1)):
-            for kx in range(-n_lin + bi * c, min(-n_lin + bi * c + c, n_lin + 1)):
-                total = 0
-                for i in range(n_pts):
-                    cx = bx[a, i] + kx
-                    cy = by[a, i] + ky
-                    if 0 <= cx < width and 0 <= cy < height:
-                        total += int(fine[cy, cx])
+        # the block's translations summed point by point, then scored in the same order
+        ky0 = -n_lin + bj * c
+        kx0 = -n_lin + bi * c
+        ny = min(c, n_lin + 1 - ky0)
+        nx = min(c, n_lin + 1 - kx0)
+        block[:, :] = 0
+        for i in range(n_pts):
+            y0i = by[a, i] + ky0
+            x0i = bx[a, i] + kx0
+            if y0i >= 0 and x0i >= 0 and y0i + ny <= height and x0i + nx <= width:
+                for j in range(ny):
+                    for k in range(nx):
+                        block[j, k] += int(fine[y0i + j, x0i + k])
+                continue
+            for j in range(ny):
+                cy = y0i + j
+                if cy < 0 or cy >= height:
+                    continue
+                for k in range(nx):
+                    cx = x0i + k
+                    if 0 <= cx < width:
+                        block[j, k] += int(fine[cy, cx])
+        for j in range(ny):
+            ky = ky0 + j
+            for k in range(nx):
+                kx = kx0 + k
                 evaluated += 1
                 d2 = 0.5 * ((kx * kx + ky * ky) / w_lin + da * da / w_rot)
-                score = total / (255.0 * n_pts) * (1.0 - penalty * d2)
+                score = block[j, k] / (255.0 * n_pts) * (1.0 - penalty * d2)
                 if score > best:
                     best = score
                     best_kx, best_ky, best_a = kx, ky, a

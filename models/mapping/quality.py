@@ -21,8 +21,9 @@ without scale, as evo computes ATE).
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
+import numba
 import numpy as np
 import numpy.typing as npt
 
@@ -63,19 +64,74 @@ def map_scores(cells: Int8Array, truth: Int8Array, seen: BoolArray) -> MapScores
         truth: ground-truth cells (0 free, 100 occupied).
         seen: the observable cells (:func:`observable`).
     """
-    known = cells != UNKNOWN
-    coverage = np.count_nonzero(known & seen) / max(1, int(np.count_nonzero(seen)))
-    mapped = cells == OCCUPIED
-    real = (truth == OCCUPIED) & known
-    union = np.count_nonzero(mapped | real)
-    strict = np.count_nonzero(mapped & real) / union if union else 1.0
-    right = np.count_nonzero(mapped & dilate(truth == OCCUPIED))
-    missed = np.count_nonzero(real & ~dilate(mapped))
-    total = np.count_nonzero(mapped) + missed
+    counts = np.zeros(_COUNTS, dtype=np.int64)
+    _count(
+        np.ascontiguousarray(cells),
+        np.ascontiguousarray(truth),
+        np.ascontiguousarray(seen, dtype=np.bool_),
+        counts,
+    )
+    seen_n, known_seen, known_n, mapped_n, union, both, right, missed, correct = (
+        int(v) for v in counts
+    )
+    coverage = known_seen / max(1, seen_n)
+    strict = both / union if union else 1.0
+    total = mapped_n + missed
     iou = right / total if total else 1.0
-    correct = np.count_nonzero(known & (cells == truth))
-    accuracy = correct / max(1, int(np.count_nonzero(known)))
+    accuracy = correct / max(1, known_n)
     return MapScores(float(coverage), float(iou), float(accuracy), float(strict))
+
+
+_COUNTS = 9
+
+
+def _near_py(cells: Any, value: int, iy: int, ix: int) -> bool:
+    """Whether ``value`` lies in the 3 x 3 neighbourhood of cell (iy, ix) (clipped)."""
+    height, width = cells.shape
+    for y in range(max(0, iy - 1), min(height, iy + 2)):
+        for x in range(max(0, ix - 1), min(width, ix + 2)):
+            if cells[y, x] == value:
+                return True
+    return False
+
+
+def _count_py(cells: Any, truth: Any, seen: Any, counts: Any) -> None:
+    """The cell counts of :func:`map_scores`, in one pass (dilations as neighbourhoods).
+
+    ``counts``: observable, known and observable, known, mapped (occupied), mapped or
+    really occupied among the known, both, mapped near a real obstacle, real obstacles
+    known with no mapped cell near, known and right.
+    """
+    height, width = cells.shape
+    for iy in range(height):
+        for ix in range(width):
+            v = cells[iy, ix]
+            t = truth[iy, ix]
+            known = v != UNKNOWN
+            mapped = v == OCCUPIED
+            real = known and t == OCCUPIED
+            if seen[iy, ix]:
+                counts[0] += 1
+                if known:
+                    counts[1] += 1
+            if known:
+                counts[2] += 1
+                if v == t:
+                    counts[8] += 1
+            if mapped:
+                counts[3] += 1
+                if _near(truth, OCCUPIED, iy, ix):
+                    counts[6] += 1
+            if mapped or real:
+                counts[4] += 1
+                if mapped and real:
+                    counts[5] += 1
+            if real and not _near(cells, OCCUPIED, iy, ix):
+                counts[7] += 1
+
+
+_near: Any = numba.njit(cache=True, inline="always")(_near_py)
+_count: Any = numba.njit(cache=True)(_count_py)
 
 
 def dilate(cells: BoolArray) -> BoolArray:

@@ -25,6 +25,7 @@ at the lowest y, like the occupancy grid they come from.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 from typing import Any
@@ -32,7 +33,6 @@ from typing import Any
 import numba
 import numpy as np
 import numpy.typing as npt
-from scipy import ndimage
 
 from models.arrays import FloatArray, IntArray, UInt8Array
 from models.errors import ModelError
@@ -204,9 +204,123 @@ def _stamp_discs_py(
                     cost[iy - oy, ix - ox] = _combine(cost[iy - oy, ix - ox], np.uint8(v))
 
 
+def _squared_edt_py(obstacle: Any, d2: Any) -> None:
+    """Squared distances (cells^2) from each cell centre to the nearest obstacle cell centre.
+
+    Exact, in integers: a vertical pass, then per row the lower envelope of the parabolas
+    ``(x - q)^2 + g(q)^2`` (Felzenszwalb and Huttenlocher 2012) with the intersections of
+    two parabolas compared as fractions, never rounded. ``-1`` when there is no obstacle.
+    """
+    rows, cols = obstacle.shape
+    far = rows + 1  # no obstacle in the column: longer than any vertical distance
+    g = np.empty((rows, cols), dtype=np.int64)  # vertical distance, row by row (cache order)
+    for c in range(cols):
+        g[0, c] = 0 if obstacle[0, c] else far
+    for r in range(1, rows):
+        for c in range(cols):
+            g[r, c] = 0 if obstacle[r, c] else min(g[r - 1, c] + 1, far)
+    for r in range(rows - 2, -1, -1):
+        for c in range(cols):
+            g[r, c] = min(g[r, c], g[r + 1, c] + 1)
+    v = np.empty(cols, dtype=np.int64)  # columns of the envelope's parabolas
+    f = np.empty(cols, dtype=np.int64)  # their heights g^2
+    h = np.empty(cols, dtype=np.int64)  # g^2 + v^2
+    zn = np.empty(cols, dtype=np.int64)  # where each starts: zn / zd (zd > 0)
+    zd = np.empty(cols, dtype=np.int64)
+    for r in range(rows):
+        k = -1
+        for q in range(cols):
+            gq = g[r, q]
+            if gq >= far:
+                continue
+            hq = gq * gq + q * q
+            sn = 0
+            sd = 1
+            while k >= 0:
+                # parabola q lies below parabola v[k] from sn / sd on
+                sn = hq - h[k]
+                sd = 2 * (q - v[k])
+                if k > 0 and sn * zd[k] <= zn[k] * sd:
+                    k -= 1
+                else:
+                    break
+            k += 1
+            v[k] = q
+            f[k] = gq * gq
+            h[k] = hq
+            zn[k] = sn
+            zd[k] = sd
+        if k < 0:
+            for c in range(cols):
+                d2[r, c] = -1
+            continue
+        j = 0
+        for c in range(cols):
+            while j < k and zn[j + 1] < c * zd[j + 1]:
+                j += 1
+            dc = c - v[j]
+            d2[r, c] = dc * dc + f[j]
+
+
+def _costs_of_py(d2: Any, resolution_m: float, table: Any, distance: Any, cost: Any) -> None:
+    """Distances (m, float32) and costs (by squared distance from ``table``) of every cell."""
+    rows, cols = d2.shape
+    size = table.shape[0]
+    for r in range(rows):
+        for c in range(cols):
+            e = d2[r, c]
+            if e < 0:
+                distance[r, c] = np.inf
+                cost[r, c] = 0
+            else:
+                # scipy's arithmetic: the square root of the integer sum, then the scale
+                distance[r, c] = math.sqrt(float(e)) * resolution_m
+                cost[r, c] = table[e] if e < size else 0
+
+
 _combine: Any = numba.njit(cache=True)(_combine_py)
 _stamp_points: Any = numba.njit(cache=True)(_stamp_points_py)
 _stamp_discs: Any = numba.njit(cache=True)(_stamp_discs_py)
+_squared_edt: Any = numba.njit(cache=True)(_squared_edt_py)
+_costs_of: Any = numba.njit(cache=True)(_costs_of_py)
+
+
+def _inflated(
+    obstacle: npt.NDArray[np.bool_], resolution_m: float, params: CostmapParams
+) -> tuple[UInt8Array, Float32Array]:
+    """Costs and distances (m) of every cell from the obstacle cells (new arrays).
+
+    Cell for cell what scipy's exact ``distance_transform_edt`` times ``resolution_m``
+    gives, then :func:`inflation_cost` of it, in one compiled pass (4 ms for scipy,
+    numpy's inflation and the copies on 324 x 324 cells, against under 1 ms).
+    """
+    d2 = np.empty(obstacle.shape, dtype=np.int64)
+    _squared_edt(np.ascontiguousarray(obstacle, dtype=np.bool_), d2)
+    distance = np.empty(obstacle.shape, dtype=np.float32)
+    cost = np.empty(obstacle.shape, dtype=np.uint8)
+    _costs_of(d2, resolution_m, _cost_table(params, resolution_m), distance, cost)
+    return cost, distance
+
+
+@functools.lru_cache(maxsize=16)
+def _cost_table(params: CostmapParams, resolution_m: float) -> UInt8Array:
+    table = cost_table(params, resolution_m)
+    table.setflags(write=False)
+    return table
+
+
+def cost_table(params: CostmapParams, resolution_m: float) -> UInt8Array:
+    """:func:`inflation_cost` by squared distance in cells, up to where it falls to 0.
+
+    Entry ``e`` is the cost at ``sqrt(e) * resolution_m`` metres, computed by
+    :func:`inflation_cost` itself; every squared distance past the table costs 0.
+    """
+    reach = params.inflation_radius_m / resolution_m + 2.0
+    e = np.arange(math.ceil(reach * reach) + 1, dtype=np.int64)
+    table = inflation_cost(np.sqrt(e.astype(np.float64)) * resolution_m, params)
+    if table[-1] != 0:  # the table must reach past the inflation radius
+        raise AssertionError("cost table too short")
+    return table
 
 
 @dataclass(frozen=True, eq=False)
@@ -259,19 +373,42 @@ class StaticCostmap:
             The static costmap covering the same cells as ``grid``.
         """
         data = grid.data
-        obstacle = data >= lethal_threshold
-        if obstacle.any():
-            distance = ndimage.distance_transform_edt(~obstacle) * grid.resolution_m
-        else:
-            distance = np.full(data.shape, np.inf)
-        cost = inflation_cost(distance, params)
+        cost, distance = _inflated(data >= lethal_threshold, float(grid.resolution_m), params)
         unknown = (data == -1) & (cost < INSCRIBED)
         cost[unknown] = NO_INFORMATION
         return cls(
             cost=cost,
-            distance_m=distance.astype(np.float32),
+            distance_m=distance,
             resolution_m=float(grid.resolution_m),
             origin_xy_m=(float(grid.origin_xy_m[0]), float(grid.origin_xy_m[1])),
+            params=params,
+        )
+
+    @classmethod
+    def from_obstacles(
+        cls,
+        obstacle: npt.NDArray[np.bool_],
+        resolution_m: float,
+        origin_xy_m: tuple[float, float],
+        params: CostmapParams,
+    ) -> StaticCostmap:
+        """Inflate a grid's obstacle cells, every other cell known and free.
+
+        The same costmap as :meth:`from_grid` of a grid holding 100 on ``obstacle`` and 0
+        elsewhere, without building that grid.
+
+        Args:
+            obstacle: (rows, cols) cells holding an obstacle, row 0 at the lowest y.
+            resolution_m: cell edge length (m/cell).
+            origin_xy_m: ``map`` position (x, y) of the lower-left corner of cell (0, 0) (m).
+            params: the inflation parameters.
+        """
+        cost, distance = _inflated(obstacle, float(resolution_m), params)
+        return cls(
+            cost=cost,
+            distance_m=distance,
+            resolution_m=float(resolution_m),
+            origin_xy_m=(float(origin_xy_m[0]), float(origin_xy_m[1])),
             params=params,
         )
 

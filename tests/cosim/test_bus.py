@@ -1,6 +1,7 @@
 from collections.abc import Sequence
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from cosim.bus import Bus, Envelope
@@ -291,3 +292,49 @@ def test_publishing_many_with_unmatched_lists_is_refused_before_anything_is_sent
         bus.publish_many(topics, messages, sources)
     kernel.run(1_000)
     assert got == [] and bus.published == 0 and sum(recorder.counts.values()) == 0
+
+
+def _recorded(batched: bool) -> Recorder:
+    """Broadcasts, a lost copy, a local delivery; chunks of 2 rows cut through broadcasts."""
+    d, g, h, z = HostId("d"), HostId("g"), HostId("h"), HostId("z")
+    sends = [
+        (
+            A,
+            "/x",
+            [Transfer(z, DeliveryStatus.DELIVERED, 5), Transfer(B, DeliveryStatus.LOST, None)],
+        ),
+        (A, "/y", [Transfer(d, DeliveryStatus.DELIVERED, 6)]),
+        (
+            C,
+            "/x",
+            [Transfer(A, DeliveryStatus.DELIVERED, 7), Transfer(g, DeliveryStatus.DELIVERED, 9)],
+        ),
+        (h, "/z", [Transfer(h, DeliveryStatus.DELIVERED, 3)]),  # h first as a source
+        (z, "/y", [Transfer(A, DeliveryStatus.QUEUE_FULL, None)] * 3),
+    ]
+    recorder = Recorder()
+    for k, (src, topic, transfers) in enumerate(sends):
+        if batched:
+            recorder.on_transmission(k, src, topic, 10 + k, transfers)
+        else:
+            for t in transfers:
+                recorder.on_transfer(k, t.t_recv_ns, src, t.dst, topic, 10 + k, t.status)
+    return recorder
+
+
+def test_a_transmission_recorded_at_once_gives_the_rows_codes_and_counts_of_each_in_turn(
+    monkeypatch,
+):
+    """Hosts are coded per chunk, sources first: the chunks must be cut where they were.
+
+    Rows 4 and 5 share a chunk: h (source of row 5) is coded before g (destination of row 4).
+    """
+    monkeypatch.setattr("cosim.records._FLUSH_ROWS", 2)
+    batched, one_by_one = _recorded(batched=True), _recorded(batched=False)
+    frame, expected = batched.messages_frame(), one_by_one.messages_frame()
+    pd.testing.assert_frame_equal(frame, expected)
+    hosts = list(frame["src_host"].cat.categories)
+    assert hosts == list(expected["src_host"].cat.categories) == ["a", "z", "b", "c", "d", "h", "g"]
+    assert len(frame) == 9 and batched.counts == one_by_one.counts
+    assert (batched.network_messages, batched.network_bytes) == (8, 97)
+    assert (one_by_one.network_messages, one_by_one.network_bytes) == (8, 97)

@@ -11,6 +11,8 @@ from models.occupancy import (
     OccupancyGrid,
     ground_truth_grid,
     rasterize_boxes,
+    resample,
+    resampled_obstacles,
 )
 from models.world import WarehouseSpec, generate_warehouse
 
@@ -141,3 +143,24 @@ def test_a_warehouse_grid_occupies_every_shelf_and_is_conservative():
         corners = np.array([[xmin, ymin], [xmax, ymin], [xmin, ymax], [xmax, ymax]])
         inward = corners + np.array([[1, 1], [-1, 1], [1, -1], [-1, -1]]) * 1e-4
         assert np.all(grid.values_at(inward) == OCCUPIED)
+
+
+@pytest.mark.parametrize(
+    ("shape", "from_res", "to_res"),
+    [((648, 648), 0.05, 0.1), ((37, 53), 0.05, 0.15), ((20, 21), 0.1, 0.1), ((9, 8), 0.025, 0.1)],
+)
+def test_obstacles_found_in_whole_blocks_are_those_of_the_resampled_grid(shape, from_res, to_res):
+    rng = np.random.default_rng(11)
+    data = rng.choice(
+        np.array([UNKNOWN, FREE, OCCUPIED], dtype=np.int8), shape, p=[0.6, 0.39, 0.01]
+    )
+    expected = resample(OccupancyGrid(from_res, (0.0, 0.0), data), to_res).data >= OCCUPIED
+    obstacles = resampled_obstacles(data, from_res, to_res)
+    assert obstacles is not None
+    assert obstacles.any() and np.array_equal(obstacles, expected)
+
+
+def test_obstacles_are_not_found_by_blocks_when_cells_do_not_fit_whole():
+    data = np.zeros((10, 10), dtype=np.int8)
+    assert resampled_obstacles(data, 0.05, 0.12) is None
+    assert resampled_obstacles(data, 0.1, 0.05) is None

@@ -2,6 +2,7 @@ import numpy as np
 
 from adapters.assignment.protocols import BasisDecoder, SimplexProtocol
 from cosim.messages import Message, SimplexBasis
+from models.assignment.dsimplex import SharedBasis
 from models.assignment.problem import AssignmentProblem, Column, ColumnKind
 
 
@@ -31,8 +32,9 @@ def test_a_basis_is_decoded_once_per_sender_until_its_wire_form_changes():
     decoder = BasisDecoder()
     wire = ((0, 1, 2, 3.5), (1, 0, -1, 1e6))
     first = decoder.decode(SimplexBasis(1, 0, "robot_1", 1, wire))
-    assert first == [Column(ColumnKind(0), 1, 2, 3.5), Column(ColumnKind(1), 0, -1, 1e6)]
-    # the same wire tuple again (the sender kept it): the same list, for every receiver
+    assert first == (Column(ColumnKind(0), 1, 2, 3.5), Column(ColumnKind(1), 0, -1, 1e6))
+    assert isinstance(first, SharedBasis) and first.column_set == frozenset(first)
+    # the same wire tuple again (the sender kept it): the same basis, for every receiver
     assert decoder.decode(SimplexBasis(2, 0, "robot_1", 2, wire)) is first
     # an equal tuple that is another object is decoded again, and so is another sender's
     again = decoder.decode(SimplexBasis(3, 0, "robot_1", 3, tuple(list(wire))))

@@ -16,7 +16,7 @@ import math
 import numpy as np
 import pytest
 
-from models.assignment.dsimplex import SimplexAgent, agent_for, run_synchronous
+from models.assignment.dsimplex import SharedBasis, SimplexAgent, agent_for, run_synchronous
 from models.assignment.problem import AssignmentProblem, hungarian, objective
 from models.assignment.simplex import assignment_of, primal, solve
 from models.errors import ModelError
@@ -205,3 +205,39 @@ def test_bases_resent_as_the_same_objects_give_the_rounds_fresh_copies_give(
                 fresh[i].unchanged,
             )
         sent = [s if s and s == shared[i].basis else shared[i].basis for i, s in enumerate(sent)]
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_bases_received_with_their_column_sets_give_the_rounds_plain_lists_give(
+    seed, make_lp, make_graph
+):
+    problem = make_lp(seed)
+    n = len(problem.robots)
+    edges = make_graph(GRAPHS[seed % 3], n, np.random.default_rng(seed + 10**6))
+    neighbours = {
+        i: [j for a, b in edges for i2, j in ((a, b), (b, a)) if i2 == i] for i in range(n)
+    }
+    bound = _diameter(n, edges)
+    keyed = [agent_for(problem, [i], bound) for i in range(n)]
+    plain = [agent_for(problem, [i], bound) for i in range(n)]
+    sent: list[SharedBasis | None] = [None] * n  # kept until the basis changes
+    solves = 0
+    for _round in range(ROUNDS_PER_STOPPING_WINDOW * (2 * bound + 1)):
+        inbox_keyed = [[sent[j] for j in neighbours[i] if sent[j] is not None] for i in range(n)]
+        inbox_plain = [[list(b) for b in inbox] for inbox in inbox_keyed]
+        for i in range(n):
+            a = keyed[i].merge_and_solve(inbox_keyed[i])
+            b = plain[i].merge_and_solve(inbox_plain[i])
+            assert (a, keyed[i].solved, keyed[i].basis, keyed[i].unchanged) == (
+                b,
+                plain[i].solved,
+                plain[i].basis,
+                plain[i].unchanged,
+            )
+            solves += keyed[i].solved
+        sent = [
+            s if s is not None and list(s) == keyed[i].basis else SharedBasis(keyed[i].basis)
+            for i, s in enumerate(sent)
+        ]
+    assert solves > n  # the sets were merged into solves, not only skipped
+    assert all(agent.converged for agent in keyed)

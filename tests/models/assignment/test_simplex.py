@@ -9,6 +9,7 @@ from models.assignment.pivoting import _exact_sign_py
 from models.assignment.problem import (
     AssignmentProblem,
     Column,
+    ColumnKind,
     LpShape,
     hungarian,
     idle,
@@ -16,7 +17,7 @@ from models.assignment.problem import (
     pair,
     unserved,
 )
-from models.assignment.simplex import assignment_of, lex_simplex, primal, solve
+from models.assignment.simplex import _layout, assignment_of, lex_simplex, primal, solve
 from models.errors import ModelError
 
 
@@ -153,3 +154,47 @@ def test_matchings_that_differ_below_the_rounding_error_are_still_ranked_exactly
     better = {0: 0, 1: 1} if flip else {0: 1, 1: 0}
     assert assignment_of(problem.shape, basis) == better
     assert objective(problem, better) == 0.3 < objective(problem, {0: 1 - better[0], 1: better[0]})
+
+
+def _layout_by_loop(shape, columns):
+    """Rank, first and second row of each column, one column at a time (the reference)."""
+    r, t = shape
+    rank, first, second = [], [], []
+    for c in columns:
+        rank.append((c.kind * (r + 1) + c.robot + 1) * (t + 1) + c.task + 1)
+        first.append(r + c.task if c.kind is ColumnKind.UNSERVED else c.robot)
+        second.append(r + c.task if c.kind is ColumnKind.PAIR else r + t)
+    return tuple(np.array(v, dtype=np.int64) for v in (rank, first, second))
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_columns_laid_out_as_whole_arrays_equal_the_layout_column_by_column(seed):
+    rng = np.random.default_rng(seed)
+    shape = LpShape(int(rng.integers(1, 9)), int(rng.integers(1, 9)))
+    r, t = shape
+    columns = [
+        pair(int(rng.integers(r)), int(rng.integers(t)), float(rng.random())) for _ in range(30)
+    ]
+    columns += [idle(i) for i in range(r)] + [unserved(j, 99.0) for j in range(t)]
+    rng.shuffle(columns)
+    got = _layout(shape, columns, "columns")
+    assert all(g.dtype == np.int64 for g in got)
+    assert all(
+        np.array_equal(g, w) for g, w in zip(got, _layout_by_loop(shape, columns), strict=True)
+    )
+
+
+@pytest.mark.parametrize(
+    "bad",
+    [
+        Column(ColumnKind.IDLE, 0, 0, 0.0),  # an idle column with a task
+        Column(ColumnKind.UNSERVED, 1, 0, 9.0),  # an unserved column with a robot
+        Column(ColumnKind.PAIR, 0, 2, 1.0),  # a task out of range
+        Column(0, 0, 0, 1.0),  # a kind that is no ColumnKind
+    ],
+)
+def test_the_first_column_out_of_range_is_named_whatever_the_layout(bad):
+    columns = [pair(0, 0, 1.0), idle(1), bad, pair(1, 1, 2.0)]
+    with pytest.raises(ModelError, match="indices within") as raised:
+        _layout(SHAPE, columns, "columns")
+    assert raised.value.key == "columns" and raised.value.value == bad

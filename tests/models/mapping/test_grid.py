@@ -1,10 +1,11 @@
 import math
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from models.mapping.grid import COARSE, LogOddsMap, LogOddsParams, MapGeometry
+from models.mapping.grid import COARSE, LogOddsMap, LogOddsParams, MapGeometry, merged
 from models.mapping.kernels import rebuild_scores
 from models.occupancy import FREE, OCCUPIED, UNKNOWN
 from tests.models.mapping.conftest import GEOMETRY, ROOM, Lidar, integrate, room_map
@@ -137,3 +138,68 @@ def test_the_default_update_rule_is_octomaps_with_a_weak_miss():
     assert math.isclose(p.hit, math.log(0.7 / 0.3))
     assert math.isclose(p.miss, math.log(0.48 / 0.52))
     assert math.isclose(p.occupied, math.log(0.65 / 0.35))
+
+
+def test_maps_fused_one_after_the_other_equal_the_sum_of_their_stack_bit_for_bit():
+    """float32 sums depend on their order: the fleet map keeps that of np.sum over axis 0."""
+    rng = np.random.default_rng(7)
+    geometry = MapGeometry.covering((-0.2, -0.2, 12.2, 8.2), 0.05, 1.0)
+    maps = [LogOddsMap(geometry) for _ in range(12)]
+    for grid in maps:
+        values = rng.normal(0.0, 2.0, grid.logodds.shape).astype(np.float32)
+        grid.logodds[:] = np.where(rng.random(values.shape) < 0.5, values, 0.0)
+    p = maps[0].params
+    # one cell whose class depends on the order: (free + 1e8) - 1e8 is 0 in float32
+    maps[0].logodds[5, 5], maps[1].logodds[5, 5], maps[2].logodds[5, 5] = p.free - 1.0, 1e8, -1e8
+    for grid in maps[3:]:
+        grid.logodds[5, 5] = 0.0
+    total = np.clip(np.sum([m.logodds for m in maps], axis=0), p.clamp_min, p.clamp_max)
+    expected = np.full(total.shape, UNKNOWN, dtype=np.int8)
+    expected[total <= p.free] = FREE
+    expected[total >= p.occupied] = OCCUPIED
+    fused = merged(maps).data
+    assert np.array_equal(fused, expected)
+    assert (fused == FREE).any() and (fused == OCCUPIED).any() and (fused == UNKNOWN).any()
+    assert fused[5, 5] == UNKNOWN  # added the other way round it would be free
+
+
+@pytest.mark.parametrize("wide", [False, True])
+def test_trinary_cells_equal_those_of_numpys_comparisons_at_and_around_the_thresholds(wide):
+    """numpy compares float32 log-odds with a float threshold in float32, with a float64
+    one in float64; the compiled classification must do the same, at the edges too."""
+    geometry = MapGeometry.covering((0.0, 0.0, 2.0, 2.0), 0.05, 0.0)
+    kind = np.float64 if wide else float
+    # float32(0.7) < 0.7: the cell at float32(0.7) is occupied in float64 only
+    params = LogOddsParams(occupied=kind(0.7), free=kind(-0.7))
+    grid = LogOddsMap(geometry, params)
+    edges = []
+    for t in (params.free, params.occupied):
+        for v in (np.float32(t), np.float64(t)):
+            edges += [np.nextafter(np.float32(v), np.float32(-9)), np.float32(v)]
+            edges += [np.nextafter(np.float32(v), np.float32(9))]
+    values = np.random.default_rng(2).normal(0.0, 1.0, grid.logodds.size).astype(np.float32)
+    values[: len(edges)] = edges
+    grid.logodds[:] = values.reshape(grid.logodds.shape)
+    expected = np.full(grid.logodds.shape, UNKNOWN, dtype=np.int8)
+    expected[grid.logodds <= params.free] = FREE
+    expected[grid.logodds >= params.occupied] = OCCUPIED
+    assert np.array_equal(grid.occupancy(), expected)
+
+
+@pytest.mark.parametrize("cleared", [[(20, 20)], [(20, 20), (20, 21)], [(20, 21), (22, 20)]])
+def test_cells_cleared_next_to_equal_obstacles_leave_the_scores_rebuilt_from_scratch(cleared):
+    """Scores tied between neighbouring obstacles: clearing one keeps the other's, clearing
+    both lowers them; only cells scoring no more than a cleared cell gave are recomputed."""
+    geometry = MapGeometry.covering((0.0, 0.0, 3.0, 3.0), 0.05, 0.0)
+    grid = LogOddsMap(geometry)
+    high = grid.params.clamp_max
+    block = np.zeros((5, 5), dtype=np.float32)
+    block[[0, 0, 2], [0, 1, 0]] = high  # cells (20, 20), (20, 21), (22, 20)
+    grid.add_logodds(20, 20, block)
+    for iy, ix in cleared:
+        clear = np.full((1, 1), -2 * high, dtype=np.float32)
+        assert grid.add_logodds(iy, ix, clear) == 1
+    score, coarse, count = _rebuilt(grid)
+    assert np.array_equal(grid.score, score)
+    assert np.array_equal(grid.coarse, coarse)
+    assert grid.occupied_cells == count == 3 - len(cleared)

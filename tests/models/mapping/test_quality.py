@@ -3,7 +3,7 @@ import math
 import numpy as np
 import pytest
 
-from models.mapping.quality import align_se2, ate_rmse, map_scores, observable
+from models.mapping.quality import align_se2, ate_rmse, dilate, map_scores, observable
 from models.occupancy import FREE, OCCUPIED, UNKNOWN
 
 
@@ -62,3 +62,40 @@ def test_alignment_recovers_a_rigid_motion_and_the_ate_is_then_zero():
     assert ate_rmse(est, ref, align=True) == pytest.approx(0.0, abs=1e-9)
     assert ate_rmse(est, ref, align=False) > 1.0
     assert ate_rmse(ref + np.array([0.3, 0.4]), ref, align=False) == pytest.approx(0.5)
+
+
+def _scores_by_masks(cells, truth, seen):
+    """The scores as first written, with whole-grid masks and shifted-OR dilations."""
+    known = cells != UNKNOWN
+    coverage = np.count_nonzero(known & seen) / max(1, int(np.count_nonzero(seen)))
+    mapped = cells == OCCUPIED
+    real = (truth == OCCUPIED) & known
+    union = np.count_nonzero(mapped | real)
+    strict = np.count_nonzero(mapped & real) / union if union else 1.0
+    right = np.count_nonzero(mapped & dilate(truth == OCCUPIED))
+    missed = np.count_nonzero(real & ~dilate(mapped))
+    total = np.count_nonzero(mapped) + missed
+    iou = right / total if total else 1.0
+    correct = np.count_nonzero(known & (cells == truth))
+    accuracy = correct / max(1, int(np.count_nonzero(known)))
+    return (float(coverage), float(iou), float(accuracy), float(strict))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_scores_counted_cell_by_cell_equal_the_scores_of_whole_grid_masks(seed):
+    rng = np.random.default_rng(seed)
+    shape = tuple(rng.integers(1, 30, 2))
+    values = np.array([UNKNOWN, FREE, OCCUPIED], dtype=np.int8)
+    cells = rng.choice(values, shape, p=rng.dirichlet(np.ones(3)))
+    truth = rng.choice(values[1:], shape, p=[0.8, 0.2])
+    seen = rng.random(shape) < 0.7
+    assert map_scores(cells, truth, seen) == _scores_by_masks(cells, truth, seen)
+
+
+def test_scores_of_an_empty_map_and_an_empty_truth_equal_those_of_whole_grid_masks():
+    truth, room = _room()
+    empty = np.full_like(truth, UNKNOWN)
+    seen = observable(truth, room)
+    assert map_scores(empty, truth, seen) == _scores_by_masks(empty, truth, seen)
+    free = np.zeros_like(truth)
+    assert map_scores(truth, free, seen) == _scores_by_masks(truth, free, seen)

@@ -2,6 +2,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from models.errors import ModelError
 from models.navigation.costmap import (
@@ -189,3 +191,52 @@ def test_impossible_inflation_parameters_are_rejected_with_their_key(kwargs, key
     with pytest.raises(ModelError) as err:
         CostmapParams(**kwargs)
     assert err.value.key == key
+
+
+def _scipy_layer(obstacle, res, params):
+    """The static layer as it was built before the compiled transform: scipy, then numpy."""
+    from scipy import ndimage
+
+    if obstacle.any():
+        distance = ndimage.distance_transform_edt(~obstacle) * res
+    else:
+        distance = np.full(obstacle.shape, np.inf)
+    return inflation_cost(distance, params), distance.astype(np.float32)
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    shape=st.tuples(st.integers(1, 40), st.integers(1, 40)),
+    density=st.sampled_from([0.0, 0.002, 0.02, 0.2, 0.7, 1.0]),
+    seed=st.integers(0, 2**32 - 1),
+    res=st.sampled_from([0.05, 0.1, 0.3]),
+)
+def test_distances_and_costs_equal_scipys_exact_transform_bit_for_bit(shape, density, seed, res):
+    obstacle = np.random.default_rng(seed).random(shape) < density
+    grid = OccupancyGrid(res, (0.0, 0.0), np.where(obstacle, OCCUPIED, 0).astype(np.int8))
+    layer = StaticCostmap.from_grid(grid, PARAMS)
+    cost, distance = _scipy_layer(obstacle, res, PARAMS)
+    assert np.array_equal(layer.distance_m, distance)
+    assert np.array_equal(layer.cost, cost)
+
+
+def test_distances_equal_scipys_on_a_large_sparse_map_with_ties():
+    """Obstacles on a lattice: many cells are as far from two or four of them."""
+    obstacle = np.zeros((324, 300), dtype=bool)
+    obstacle[::17, ::23] = True
+    obstacle[100:140, 200] = True
+    grid = OccupancyGrid(0.1, (0.0, 0.0), np.where(obstacle, OCCUPIED, 0).astype(np.int8))
+    layer = StaticCostmap.from_grid(grid, PARAMS)
+    cost, distance = _scipy_layer(obstacle, 0.1, PARAMS)
+    assert np.array_equal(layer.distance_m, distance)
+    assert np.array_equal(layer.cost, cost)
+
+
+def test_a_layer_from_obstacle_cells_equals_the_layer_of_their_grid():
+    obstacle = np.random.default_rng(3).random((50, 70)) < 0.05
+    data = np.where(obstacle, OCCUPIED, 0).astype(np.int8)
+    expected = StaticCostmap.from_grid(OccupancyGrid(0.1, (-1.5, 2.0), data), PARAMS)
+    layer = StaticCostmap.from_obstacles(obstacle, 0.1, (-1.5, 2.0), PARAMS)
+    assert np.array_equal(layer.cost, expected.cost)
+    assert np.array_equal(layer.distance_m, expected.distance_m)
+    assert (layer.resolution_m, layer.origin_xy_m) == (0.1, (-1.5, 2.0))

@@ -14,7 +14,7 @@ from models.network import (
     Partition,
     PathLoss,
 )
-from models.network.topology import ring
+from models.network.topology import complete, ring
 
 MS = 1_000_000
 
@@ -258,3 +258,49 @@ def test_impossible_network_parameters_are_refused_with_their_keys(streams):
     with pytest.raises(ModelError) as error:
         network(streams, queue=-1)
     assert error.value.key == "network.queue_packets"
+
+
+@pytest.mark.parametrize(("latency_ms", "reorder"), [(0.0, False), (3.5, False), (1.0, True)])
+def test_an_ideal_network_delivers_as_its_links_would_without_drawing_them(
+    make_streams, latency_ms, reorder
+):
+    """Forced through its links (every pair listed as an edge), the same network decides
+    every copy the same way; unforced it asks for no random stream at all."""
+    hosts = [f"h{i}" for i in range(6)]
+    asked: list[list[str]] = [[], []]
+
+    def counted(k):
+        streams = make_streams(3)
+        return lambda name: (asked[k].append(name), streams(name))[1]
+
+    fast = network(counted(0), latency=ConstantLatency(latency_ms), reorder=reorder)
+    forced = network(counted(1), latency=ConstantLatency(latency_ms), reorder=reorder)
+    forced.set_edges(frozenset(complete(hosts)))
+    rng = np.random.default_rng(5)
+    t = 0
+    for _ in range(600):  # more than a block of 256 draws on some links
+        t += int(rng.integers(0, 3)) * MS
+        src = hosts[int(rng.integers(len(hosts)))]
+        dsts = [h for h in hosts if h != src and rng.random() < 0.8]
+        outcome = fast.transmit(t, src, dsts, 100, no_distance)
+        assert outcome == forced.transmit(t, src, dsts, 100, no_distance)
+        assert outcome == [(d, Fate.DELIVERED, t + round(latency_ms * MS)) for d in dsts]
+    assert asked[0] == [] and len(asked[1]) == 30
+    with pytest.raises(ValueError, match="cannot send to itself"):
+        fast.transmit(t, "h0", ["h1", "h0"], 100, no_distance)
+
+
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        {"latency": NormalLatency(2.0, 0.5)},
+        {"loss": lambda: BernoulliLoss(0.1)},
+        {"range_m": 30.0},
+        {"bandwidth_bps": 1e6},
+        {"partitions": [Partition(0, MS, hosts=frozenset({"a"}))]},
+    ],
+)
+def test_a_network_that_can_drop_delay_or_reorder_goes_through_its_links(streams, kwargs):
+    net = network(streams, **kwargs)
+    net.transmit(0, "a", ["b", "c"], 100, no_distance)
+    assert len(net._links) == 2
