@@ -68,6 +68,22 @@ class Pibt:
         other = self.standing.get(node)
         return None if other is None or other in self.nxt else other
 
+    def let_through(self, robot: int, other: int) -> None:
+        """Plan ``robot`` and ``other`` again, ``other`` first: ``robot`` gives way.
+
+        For a robot whose plan left ``other`` with no way on (a robot waiting to drive off
+        its place onto its goal, whose neighbour can only leave through its place):
+        ``other`` may now ask ``robot`` to make way. Their claims are dropped first.
+        """
+        for node, owner in list(self.claimed.items()):
+            if owner in (robot, other):
+                del self.claimed[node]
+        self.nxt.pop(robot, None)
+        self.nxt.pop(other, None)
+        self.move(other)
+        if robot not in self.nxt:
+            self.move(robot)
+
     def _take(self, robot: int, node: int) -> None:
         old = self.nxt.get(robot)
         if old is not None and self.claimed.get(old) == robot:

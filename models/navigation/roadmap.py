@@ -25,7 +25,7 @@ from scipy.spatial import cKDTree
 
 from models.arrays import BoolArray, FloatArray, IntArray, UInt8Array
 from models.errors import ModelError
-from models.navigation.lanes import EAST, NORTH, SOUTH, WEST
+from models.navigation.lanes import EAST, NORTH, SOUTH, TWO_WAY, WEST
 
 STEPS: tuple[tuple[int, int], ...] = ((1, 0), (-1, 0), (0, 1), (0, -1))
 """The four grid moves (dx, dy) in node units; column k of :attr:`Roadmap.neighbours`."""
@@ -246,3 +246,71 @@ def build_roadmap(
         )
     _, xy, neighbours = best
     return Roadmap(xy, neighbours, spacing_m)
+
+
+def one_way_floor(
+    roadmap: Roadmap, lanes: UInt8Array, origin: tuple[float, float], res: float
+) -> Roadmap:
+    """The roadmap with its open floor as a grid of alternating one-way streets.
+
+    Steps between two places off the lanes keep only the row's or column's direction:
+    rows alternate east and west, columns north and south (a unidirectional flow-path
+    network: Gaskins & Tanchoco, "Flow path design for automated guided vehicle
+    systems", Int. J. of Production Research 25(5), 1987), so no two robots ever meet
+    head-on. The rows' and the columns' parities are chosen to agree with most of the
+    lanes' steps. Places that would lose their way to, or from, the rest are left two-way.
+    """
+    if not len(roadmap):
+        return roadmap
+    ix = np.floor((roadmap.xy[:, 0] - origin[0]) / res).astype(np.int64)
+    iy = np.floor((roadmap.xy[:, 1] - origin[1]) / res).astype(np.int64)
+    lane = lanes[iy, ix]
+    col = np.rint((roadmap.xy[:, 0] - roadmap.xy[:, 0].min()) / roadmap.spacing_m).astype(np.int64)
+    row = np.rint((roadmap.xy[:, 1] - roadmap.xy[:, 1].min()) / roadmap.spacing_m).astype(np.int64)
+    along = {0: (row, EAST), 1: (row, WEST), 2: (col, NORTH), 3: (col, SOUTH)}
+
+    def parity(k_plus: int, k_minus: int) -> int:
+        """The parity whose streets run the lanes' way, by their steps (+: even lines)."""
+        line, plus = along[k_plus]
+        minus = along[k_minus][1]
+        agree = int(
+            np.sum((line % 2 == 0) & (lane == plus)) + np.sum((line % 2 == 1) & (lane == minus))
+        )
+        disagree = int(
+            np.sum((line % 2 == 0) & (lane == minus)) + np.sum((line % 2 == 1) & (lane == plus))
+        )
+        return 0 if agree >= disagree else 1
+
+    rows_even_east = parity(0, 1)
+    cols_even_north = parity(2, 3)
+    neighbours = roadmap.neighbours.copy()
+    for k in range(4):
+        other = neighbours[:, k]
+        linked = other >= 0
+        floor = linked & (lane == TWO_WAY)
+        floor[linked] &= lane[other[linked]] == TWO_WAY
+        line = row if k in (0, 1) else col
+        offset = rows_even_east if k in (0, 1) else cols_even_north
+        forward = (line + offset) % 2 == 0  # this line runs towards +x (+y)
+        bad = floor & (forward != (k in (0, 2)))
+        neighbours[bad, k] = -1
+    directed = Roadmap(roadmap.xy, neighbours, roadmap.spacing_m)
+    for _ in range(len(roadmap)):
+        stray = _stray(roadmap.component, directed.component)
+        if not stray.any():
+            break
+        # a stray place gets its steps back, both ways
+        restore = stray[:, None] | np.isin(roadmap.neighbours, np.flatnonzero(stray))
+        neighbours = np.where(restore, roadmap.neighbours, neighbours)
+        directed = Roadmap(roadmap.xy, neighbours, roadmap.spacing_m)
+    return directed
+
+
+def _stray(before: IntArray, after: IntArray) -> BoolArray:
+    """Nodes cut off from the largest part (``after``) of their component ``before``."""
+    stray = np.zeros(len(before), dtype=bool)
+    for component in np.unique(before):
+        members = before == component
+        parts, counts = np.unique(after[members], return_counts=True)
+        stray[members] = after[members] != parts[np.argmax(counts)]
+    return stray

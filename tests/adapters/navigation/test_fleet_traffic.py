@@ -5,7 +5,7 @@ import pytest
 
 import adapters.navigation.fleet_traffic as fleet_traffic
 import cosim
-from adapters.navigation.fleet_traffic import STAND, FleetTraffic
+from adapters.navigation.fleet_traffic import MOVE, STAND, FleetTraffic
 from models.errors import ModelError
 from models.navigation.costmap import CostmapParams, StaticCostmap
 from models.navigation.lanes import TWO_WAY
@@ -37,6 +37,10 @@ def test_robots_on_places_reach_goals_without_collision_and_never_share_a_place(
             np.hypot(*(poses[standing, :2] - self.roadmap.xy[self.node[standing]]).T)
             <= fleet_traffic.ARRIVE_M + 1e-9
         ).all()
+        # a robot on the places keeps every place its body still covers
+        for i in np.flatnonzero((self.mode == STAND) | (self.mode == MOVE)).tolist():
+            for u in self.roadmap.near(poses[i, :2], fleet_traffic.RELEASE_M - 0.05):
+                assert u == self.node[i] or u in self.held[i], (i, u)
         return out
 
     monkeypatch.setattr(FleetTraffic, "step", checked)

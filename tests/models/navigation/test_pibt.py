@@ -68,6 +68,21 @@ def test_a_robot_does_not_move_onto_the_node_of_a_robot_planned_before_it():
     assert nxt == {0: 2, 1: 0}
 
 
+def test_a_robot_lets_through_one_whose_only_way_on_leads_over_its_node():
+    # a one-way street 0 -> 1 -> 2 with a side node 3 off node 1: robot 0 stands on node 1
+    # (its goal) and claimed to stay; robot 1 on node 0 can only go on through node 1
+    neighbours = np.array([[1, -1, -1, -1], [2, -1, 3, -1], [-1, -1, -1, -1], [-1, -1, -1, 1]])
+    rank = _towards({0: 1, 1: 2}, 10)
+    step = Pibt({0: 1, 1: 0}, neighbours, rank, set())
+    step.move(0)
+    step.move(1)
+    assert step.nxt == {0: 1, 1: 0}  # stuck: robot 0 stays, robot 1 cannot move
+    step.let_through(0, 1)
+    assert step.nxt[1] == 1  # robot 1 goes on
+    assert step.nxt[0] == 2  # robot 0 makes way, nearest its goal and never onto node 0
+    assert step.claimed == {1: 1, 2: 0}
+
+
 @settings(max_examples=300, deadline=None)
 @given(
     width=st.integers(2, 6),

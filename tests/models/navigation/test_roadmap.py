@@ -9,7 +9,14 @@ from scipy.sparse import csgraph
 
 from models.errors import ModelError
 from models.navigation.lanes import EAST, TWO_WAY
-from models.navigation.roadmap import STEPS, UNREACHABLE, Roadmap, build_roadmap, one_way
+from models.navigation.roadmap import (
+    STEPS,
+    UNREACHABLE,
+    Roadmap,
+    build_roadmap,
+    one_way,
+    one_way_floor,
+)
 
 RES = 0.1
 CLEARANCE = 0.43  # a 0.33 m robot and a 0.1 m margin
@@ -107,3 +114,67 @@ def test_hops_to_a_place_are_the_fewest_steps_along_the_edges_directions(seed, k
     reached = np.isfinite(expected)
     assert (hops[~reached] == UNREACHABLE).all()
     np.testing.assert_array_equal(hops[reached], expected[reached].astype(np.int32))
+
+
+def _two_way(roadmap: Roadmap) -> set[tuple[int, int]]:
+    return {
+        (u, int(v))
+        for u in range(len(roadmap))
+        for v in roadmap.neighbours[u]
+        if v >= 0 and u in roadmap.neighbours[v]
+    }
+
+
+def test_the_open_floor_becomes_alternating_one_way_streets_that_still_reach_everywhere():
+    roadmap = build_roadmap(_distance(_hall_with_a_box()), (0.0, 0.0), RES, 0.8, CLEARANCE)
+    lanes = np.full((80, 100), TWO_WAY, dtype=np.uint8)
+    streets = one_way_floor(roadmap, lanes, (0.0, 0.0), RES)
+    assert len(set(streets.component.tolist())) == 1
+    row = np.rint((streets.xy[:, 1] - streets.xy[:, 1].min()) / 0.8).astype(int)
+    col = np.rint((streets.xy[:, 0] - streets.xy[:, 0].min()) / 0.8).astype(int)
+    both = {u for u, _ in _two_way(streets)}
+    one_way_only = np.array([u not in both for u in range(len(streets))])
+    east, west, north, south = ((streets.neighbours[:, k] >= 0) & one_way_only for k in range(4))
+    # a row runs one way, the next the other; so do the columns
+    for r in np.unique(row):
+        assert not (east[row == r].any() and west[row == r].any()), r
+        assert east[row == r].any() == (west[row == r + 1].any() or not (row == r + 1).any())
+    for c in np.unique(col):
+        assert not (north[col == c].any() and south[col == c].any()), c
+    assert {bool(north[col == c].any()) for c in (0, 1)} == {True, False}
+    # only places that would be cut off keep two-way steps: few of them
+    assert len(_two_way(streets)) <= 0.05 * int((streets.neighbours >= 0).sum())
+    assert len(_two_way(roadmap)) == int((roadmap.neighbours >= 0).sum())
+
+
+def test_the_streets_run_the_way_of_the_aisles_they_continue():
+    obstacle = _racks()
+    roadmap = build_roadmap(_distance(obstacle), (0.0, 0.0), RES, 0.8, CLEARANCE)
+    lanes = np.full(obstacle.shape, TWO_WAY, dtype=np.uint8)
+    lanes[28:44, 20:80] = EAST
+    streets = one_way_floor(one_way(roadmap, lanes, (0.0, 0.0), RES), lanes, (0.0, 0.0), RES)
+    band = np.flatnonzero((streets.xy[:, 1] > 2.8) & (streets.xy[:, 1] < 4.4))
+    inner = band[(streets.xy[band, 0] > 2.5) & (streets.xy[band, 0] < 7.5)]
+    (y,) = np.unique(streets.xy[inner, 1])  # the aisle holds one line of places
+    line = np.flatnonzero(np.isclose(streets.xy[:, 1], y))
+    floor = line[(streets.xy[line, 0] < 1.9) | (streets.xy[line, 0] > 8.1)]
+    assert len(floor) >= 4
+    assert (streets.neighbours[floor, 1] == -1).all()  # the row goes on east, off the aisle
+    assert len(set(streets.component.tolist())) == 1
+
+
+@settings(max_examples=40, deadline=None)
+@given(boxes=st.lists(st.tuples(st.integers(5, 90), st.integers(5, 70)), max_size=6))
+def test_streets_keep_together_every_place_that_was_reachable_before(boxes):
+    obstacle = _hall_with_a_box()
+    for x, y in boxes:
+        obstacle[y : y + 8, x : x + 8] = True
+    roadmap = build_roadmap(_distance(obstacle), (0.0, 0.0), RES, 0.8, CLEARANCE)
+    lanes = np.full(obstacle.shape, TWO_WAY, dtype=np.uint8)
+    streets = one_way_floor(roadmap, lanes, (0.0, 0.0), RES)
+    for component in np.unique(roadmap.component):
+        members = roadmap.component == component
+        assert len(np.unique(streets.component[members])) == 1
+    # and never a step that was not there
+    kept = streets.neighbours >= 0
+    assert (streets.neighbours[kept] == roadmap.neighbours[kept]).all()
