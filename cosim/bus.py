@@ -24,7 +24,7 @@ import simpy
 
 from cosim.hosts import HostId
 from cosim.kernel import Kernel, Stage
-from cosim.link import DeliveryStatus, IdealLink, Link, Transfer
+from cosim.link import AllDelivered, DeliveryStatus, IdealLink, Link, Transfer
 from cosim.messages import Message
 
 
@@ -98,6 +98,21 @@ class BusTap(Protocol):
         self, t_sent_ns: int, src: HostId, topic: str, nbytes: int, transfers: Sequence[Transfer]
     ) -> None:
         """Record one transmission's transfers, in order: :meth:`on_transfer` for each."""
+        ...
+
+    def on_all_delivered(
+        self,
+        t_sent_ns: int,
+        src: HostId,
+        topic: str,
+        nbytes: int,
+        dsts: Sequence[HostId],
+        t_recv_ns: int,
+    ) -> None:
+        """Record one transmission delivered to every host in ``dsts`` at ``t_recv_ns``.
+
+        The same as :meth:`on_transmission` with a delivered :class:`Transfer` per host.
+        """
         ...
 
 
@@ -237,17 +252,19 @@ class Bus:
         order. The order of everything is as with an event each: events of one instant and
         stage run in scheduling order, and these were scheduled back to back.
         """
-        transfers = self.link.transmit(t_sent_ns, src, remote, nbytes, topic)
-        if self.tap is not None:
-            self.tap.on_transmission(t_sent_ns, src, topic, nbytes, transfers)
-        arrivals: dict[int, list[HostId]] = {}
-        for transfer in transfers:
-            if transfer.status is not DeliveryStatus.DELIVERED or transfer.t_recv_ns is None:
-                continue
-            if transfer.t_recv_ns < t_sent_ns:
-                delay = transfer.t_recv_ns - t_sent_ns
+        outcome = self.link.transmit(t_sent_ns, src, remote, nbytes, topic)
+        arrivals: dict[int, list[HostId]]
+        if isinstance(outcome, AllDelivered):
+            # every copy at one instant: the transfers it stands for, without building them
+            t_recv_ns = outcome.t_recv_ns
+            if self.tap is not None:
+                self.tap.on_all_delivered(t_sent_ns, src, topic, nbytes, remote, t_recv_ns)
+            if t_recv_ns < t_sent_ns:
+                delay = t_recv_ns - t_sent_ns
                 raise ValueError(f"link delivered {topic} before it was sent ({delay} ns)")
-            arrivals.setdefault(transfer.t_recv_ns, []).append(transfer.dst)
+            arrivals = {t_recv_ns: list(remote)}
+        else:
+            arrivals = self._arrivals(t_sent_ns, src, topic, nbytes, outcome)
         by_host = self._topics[topic]
         for t_recv_ns, hosts in arrivals.items():
             envelope = Envelope(topic, src, t_sent_ns, t_recv_ns)
@@ -262,3 +279,24 @@ class Bus:
 
             delay = t_recv_ns - t_sent_ns
             self.kernel.timeout(delay, Stage.DELIVERY).callbacks.append(deliver)
+
+    def _arrivals(
+        self,
+        t_sent_ns: int,
+        src: HostId,
+        topic: str,
+        nbytes: int,
+        transfers: Sequence[Transfer],
+    ) -> dict[int, list[HostId]]:
+        """The hosts each delivered transfer reaches, by arrival time (ns), in order."""
+        if self.tap is not None:
+            self.tap.on_transmission(t_sent_ns, src, topic, nbytes, transfers)
+        arrivals: dict[int, list[HostId]] = {}
+        for transfer in transfers:
+            if transfer.status is not DeliveryStatus.DELIVERED or transfer.t_recv_ns is None:
+                continue
+            if transfer.t_recv_ns < t_sent_ns:
+                delay = transfer.t_recv_ns - t_sent_ns
+                raise ValueError(f"link delivered {topic} before it was sent ({delay} ns)")
+            arrivals.setdefault(transfer.t_recv_ns, []).append(transfer.dst)
+        return arrivals

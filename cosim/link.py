@@ -40,16 +40,31 @@ class Transfer:
     t_recv_ns: int | None
 
 
+@dataclass(frozen=True, slots=True)
+class AllDelivered:
+    """Outcome of a transmission delivered to every destination host at one instant.
+
+    The same as a :class:`Transfer` per destination, in order, each ``DELIVERED`` at
+    ``t_recv_ns``, without building them (a broadcast on an ideal network).
+
+    Attributes:
+        t_recv_ns: arrival time (ns) of every copy.
+    """
+
+    t_recv_ns: int
+
+
 class Link(Protocol):
     """Decides the fate of messages between hosts."""
 
     def transmit(
         self, t_ns: int, src: HostId, dsts: Sequence[HostId], nbytes: int, topic: str
-    ) -> Sequence[Transfer]:
+    ) -> Sequence[Transfer] | AllDelivered:
         """Send one message of ``nbytes`` from ``src`` at ``t_ns`` to every host in ``dsts``.
 
         One call is one transmission: a broadcast reaches several hosts with independent
-        fates. Arrival times must not lie before ``t_ns``.
+        fates, a :class:`Transfer` each in the order of ``dsts`` (or :class:`AllDelivered`
+        when every copy arrives at one instant). Arrival times must not lie before ``t_ns``.
         """
         ...
 
@@ -59,6 +74,6 @@ class IdealLink:
 
     def transmit(
         self, t_ns: int, src: HostId, dsts: Sequence[HostId], nbytes: int, topic: str
-    ) -> Sequence[Transfer]:
+    ) -> AllDelivered:
         """Deliver to every destination at ``t_ns``."""
-        return [Transfer(dst, DeliveryStatus.DELIVERED, t_ns) for dst in dsts]
+        return AllDelivered(t_ns)

@@ -241,6 +241,40 @@ class Recorder:
         if len(self._src) >= _FLUSH_ROWS:
             self._flush()
 
+    def on_all_delivered(
+        self,
+        t_sent_ns: int,
+        src: HostId,
+        topic: str,
+        nbytes: int,
+        dsts: Sequence[HostId],
+        t_recv_ns: int,
+    ) -> None:
+        """Record one transmission delivered to every host in ``dsts`` at ``t_recv_ns`` (ns).
+
+        The same rows, counts and tables as :meth:`on_transmission` with a delivered
+        transfer per host, without the transfers.
+        """
+        n = len(dsts)
+        if not n:
+            return
+        delivered = DeliveryStatus.DELIVERED
+        self.counts[delivered] += n
+        others = n - dsts.count(src)
+        self.network_messages += others
+        self.network_bytes += others * nbytes
+        if not self.record_messages:
+            return
+        self._t_sent.extend([t_sent_ns] * n)
+        self._t_recv.extend([t_recv_ns] * n)
+        self._src.extend([src] * n)
+        self._dst.extend(dsts)
+        self._topic.extend([topic] * n)
+        self._bytes.extend([nbytes] * n)
+        self._status.extend([delivered] * n)
+        if len(self._src) >= _FLUSH_ROWS:
+            self._flush()
+
     def _flush(self, *, rest: bool = False) -> None:
         """Pack the pending rows in chunks of 65,536 rows, and with ``rest`` the rest too.
 

@@ -22,7 +22,7 @@ from cosim.adapter import RunContext
 from cosim.errors import ConfigError
 from cosim.hosts import HostId, HostKind
 from cosim.kernel import Stage
-from cosim.link import DeliveryStatus, Transfer
+from cosim.link import AllDelivered, DeliveryStatus, Transfer
 from cosim.timebase import NS_PER_S, period_ns
 from models.kinematics import FleetState
 from models.network.fate import Fate
@@ -43,11 +43,15 @@ class NetworkLink:
 
     def transmit(
         self, t_ns: int, src: HostId, dsts: Sequence[HostId], nbytes: int, topic: str
-    ) -> Sequence[Transfer]:
+    ) -> Sequence[Transfer] | AllDelivered:
         """Decide the fate of one transmission towards every destination host."""
-        out = []
+        outcome = self.model.transmit_all(t_ns, src, dsts, nbytes, self.distance_m)
         latencies = self.latencies_ns
-        for dst, fate, arrival in self.model.transmit(t_ns, src, dsts, nbytes, self.distance_m):
+        if isinstance(outcome, int):  # an ideal network: every copy after the latency
+            latencies.extend([outcome - t_ns] * len(dsts))
+            return AllDelivered(outcome)
+        out = []
+        for dst, fate, arrival in outcome:
             if arrival is not None:
                 latencies.append(arrival - t_ns)
             out.append(Transfer(HostId(dst), _STATUS[fate], arrival))

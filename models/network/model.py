@@ -222,6 +222,28 @@ class NetworkModel:
             ``(dst, fate, arrival_ns)`` per destination, in the order of ``dsts``;
             ``arrival_ns`` is ``None`` unless delivered.
         """
+        outcome = self.transmit_all(t_ns, src, dsts, nbytes, distance_m)
+        if isinstance(outcome, int):
+            return [(dst, _DELIVERED, outcome) for dst in dsts]
+        return outcome
+
+    def transmit_all(
+        self, t_ns: int, src: str, dsts: Sequence[str], nbytes: int, distance_m: DistanceFn
+    ) -> int | list[Outcome]:
+        """:meth:`transmit`, with the outcomes of an ideal network as one arrival time.
+
+        Args:
+            t_ns: send time (ns); calls come in non-decreasing time.
+            src: sending host.
+            dsts: destination hosts (not ``src``), decided in this order.
+            nbytes: message size (bytes).
+            distance_m: distance (m) between two hosts, or ``None`` when unknown.
+
+        Returns:
+            The arrival time (ns) of every copy when the network is ideal (each copy
+            delivered then, as :meth:`transmit` lists them), else what :meth:`transmit`
+            returns.
+        """
         queue = self._queues.get(src) or self.queue(src)
         t_leave = queue.enqueue(t_ns, nbytes)
         if self._ideal_ns is not None and self._edges is None and t_leave is not None:
@@ -229,8 +251,7 @@ class NetworkModel:
             # in order, and the links' streams need not even be drawn
             if src in dsts:
                 raise ValueError(f"{src!r} cannot send to itself through the network")
-            arrival = t_leave + self._ideal_ns
-            return [(dst, _DELIVERED, arrival) for dst in dsts]
+            return t_leave + self._ideal_ns
         links = self._links
         params = self.params
         latency = params.latency

@@ -7,7 +7,7 @@ import pytest
 from cosim.bus import Bus, Envelope
 from cosim.hosts import HostId
 from cosim.kernel import Kernel, Stage
-from cosim.link import DeliveryStatus, Transfer
+from cosim.link import AllDelivered, DeliveryStatus, Transfer
 from cosim.messages import Message, Twist
 from cosim.records import Recorder
 from cosim.timebase import period_ns
@@ -338,3 +338,77 @@ def test_a_transmission_recorded_at_once_gives_the_rows_codes_and_counts_of_each
     assert len(frame) == 9 and batched.counts == one_by_one.counts
     assert (batched.network_messages, batched.network_bytes) == (8, 97)
     assert (one_by_one.network_messages, one_by_one.network_bytes) == (8, 97)
+
+
+class SameTimeLink:
+    """A test link delivering every copy ``delay_ns`` after sending: as one outcome or each."""
+
+    def __init__(self, delay_ns: int, *, all_at_once: bool) -> None:
+        self.delay_ns = delay_ns
+        self.all_at_once = all_at_once
+
+    def transmit(
+        self, t_ns: int, src: HostId, dsts: Sequence[HostId], nbytes: int, topic: str
+    ) -> Sequence[Transfer] | AllDelivered:
+        if self.all_at_once:
+            return AllDelivered(t_ns + self.delay_ns)
+        return [Transfer(d, DeliveryStatus.DELIVERED, t_ns + self.delay_ns) for d in dsts]
+
+
+def _broadcasts(all_at_once: bool, delay_ns: int = 1_000) -> tuple[list[object], Recorder]:
+    """Broadcasts to several hosts (one reply sent on arrival), chunks of 2 rows."""
+    kernel = Kernel()
+    recorder = Recorder()
+    bus = Bus(kernel, SameTimeLink(delay_ns, all_at_once=all_at_once), tap=recorder)
+    hosts = [HostId(f"h{k}") for k in range(5)]
+    got: list[object] = []
+    for host in hosts:
+        bus.subscribe("/x", host, lambda m, e, h=host: got.append((kernel.now_ns, h, str(m), e)))
+    bus.subscribe("/y", hosts[0], lambda m, e: got.append((kernel.now_ns, "y", str(m), e)))
+    bus.subscribe("/x", hosts[3], lambda m, e: bus.publish("/y", Twist(9.0, 0.0), HostId("h3")))
+    kernel.at(5_000, lambda: bus.publish_many(["/x", "/x"], [Twist(1.0, 0.0)] * 2, hosts[:2]))
+    kernel.at(5_000, lambda: bus.publish("/x", Twist(2.0, 0.0), hosts[4]))
+    kernel.run(20_000)
+    return got, recorder
+
+
+def test_a_link_delivering_every_copy_at_once_delivers_and_records_as_copy_by_copy(
+    monkeypatch,
+):
+    monkeypatch.setattr("cosim.records._FLUSH_ROWS", 2)
+    got, recorder = _broadcasts(all_at_once=True)
+    want_got, want = _broadcasts(all_at_once=False)
+    assert got == want_got and len(got) == 18  # 3 broadcasts: 4 remote, 1 local; 3 replies
+    pd.testing.assert_frame_equal(recorder.messages_frame(), want.messages_frame())
+    assert recorder.counts == want.counts and recorder.counts["delivered"] == 18
+    assert (recorder.network_messages, recorder.network_bytes) == (
+        want.network_messages,
+        want.network_bytes,
+    )
+
+
+@pytest.mark.parametrize("all_at_once", [True, False])
+def test_a_link_delivering_before_sending_is_refused_either_way(all_at_once):
+    with pytest.raises(ValueError, match="before it was sent"):
+        _broadcasts(all_at_once, delay_ns=-1)
+
+
+def test_a_transmission_delivered_at_once_is_recorded_as_its_transfers(monkeypatch):
+    monkeypatch.setattr("cosim.records._FLUSH_ROWS", 2)
+    a, b = Recorder(), Recorder()
+    sends = [(A, "/x", (B, C), 5), (C, "/y", (A,), 7), (B, "/x", (B, A, C), 9)]
+    for k, (src, topic, dsts, t_recv) in enumerate(sends):
+        a.on_all_delivered(k, src, topic, 10 + k, dsts, t_recv)
+        b.on_transmission(
+            k, src, topic, 10 + k, [Transfer(d, DeliveryStatus.DELIVERED, t_recv) for d in dsts]
+        )
+    pd.testing.assert_frame_equal(a.messages_frame(), b.messages_frame())
+    assert a.counts == b.counts and len(a.messages_frame()) == 6
+    assert (
+        (a.network_messages, a.network_bytes)
+        == (b.network_messages, b.network_bytes)
+        == (
+            5,
+            10 * 2 + 11 + 12 * 2,
+        )
+    )

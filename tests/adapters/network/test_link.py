@@ -9,14 +9,19 @@ import pytest
 
 import cosim
 from adapters.naming import topic
+from adapters.network.link import NetworkLink
 from cosim.adapter import RunContext
 from cosim.errors import ConfigError
 from cosim.hosts import BASE_HOST, HostId
 from cosim.kernel import Stage
+from cosim.link import AllDelivered, DeliveryStatus, Transfer
 from cosim.messages import Message
 from cosim.registry import AdapterRegistry
+from cosim.rng import RngStreams
 from cosim.runner import execute
 from models.kinematics import FleetState
+from models.network import ConstantLatency, LinkParams, NetworkModel, NoLoss
+from models.network.topology import complete
 
 
 @dataclass(frozen=True, slots=True)
@@ -223,3 +228,30 @@ def test_the_same_seed_gives_the_same_fates_under_loss_and_jitter():
     second = _run(extra)
     assert first.tables["messages"].equals(second.tables["messages"])
     assert (first.tables["messages"]["status"] == "lost").sum() > 0
+
+
+def test_the_link_over_an_ideal_network_stands_for_the_transfers_of_its_links():
+    """Every copy at once (AllDelivered) on an ideal network: the transfers and latencies of
+    the same network forced through its links."""
+    hosts = [HostId(f"h{i}") for i in range(4)]
+
+    def link(forced: bool) -> NetworkLink:
+        model = NetworkModel(
+            LinkParams(latency=ConstantLatency(3.0), loss_factory=NoLoss),
+            streams=RngStreams(1).stream,
+            bandwidth_bps=None,
+            queue_packets=100,
+        )
+        if forced:
+            model.set_edges(frozenset(complete(hosts)))
+        return NetworkLink(model, lambda a, b: None)
+
+    fast, forced = link(False), link(True)
+    for k in range(40):
+        src = hosts[k % 4]
+        dsts = [h for h in hosts if h != src][: 1 + k % 3]
+        outcome = fast.transmit(k * 1_000, src, dsts, 100, "/t")
+        assert isinstance(outcome, AllDelivered)
+        each = [Transfer(d, DeliveryStatus.DELIVERED, outcome.t_recv_ns) for d in dsts]
+        assert each == forced.transmit(k * 1_000, src, dsts, 100, "/t")
+    assert list(fast.latencies_ns) == list(forced.latencies_ns) == [3_000_000] * 79

@@ -304,3 +304,36 @@ def test_a_network_that_can_drop_delay_or_reorder_goes_through_its_links(streams
     net = network(streams, **kwargs)
     net.transmit(0, "a", ["b", "c"], 100, no_distance)
     assert len(net._links) == 2
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "ideal"),
+    [
+        ({"latency": ConstantLatency(2.0)}, True),
+        ({"latency": ConstantLatency(0.0), "reorder": True}, True),
+        ({"latency": NormalLatency(2.0, 0.5)}, False),
+        ({"loss": lambda: BernoulliLoss(0.3)}, False),
+        ({"queue": 2, "bandwidth_bps": 1e4}, False),
+    ],
+)
+def test_transmitting_to_all_at_once_stands_for_the_outcomes_transmit_lists(
+    make_streams, kwargs, ideal
+):
+    """An ideal network answers one arrival time: every copy's, as the same network forced
+    through its links (every pair listed as an edge) lists them."""
+    hosts = [f"h{i}" for i in range(5)]
+    at_once = network(make_streams(3), **kwargs)
+    each = network(make_streams(3), **kwargs)
+    each.set_edges(frozenset(complete(hosts)))
+    rng = np.random.default_rng(2)
+    t = 0
+    for _ in range(300):
+        t += int(rng.integers(0, 2)) * MS
+        src = hosts[int(rng.integers(len(hosts)))]
+        dsts = [h for h in hosts if h != src and rng.random() < 0.7]
+        outcome = at_once.transmit_all(t, src, dsts, 100, no_distance)
+        assert isinstance(outcome, int) is ideal
+        expanded = (
+            [(d, Fate.DELIVERED, outcome) for d in dsts] if isinstance(outcome, int) else outcome
+        )
+        assert expanded == each.transmit(t, src, dsts, 100, no_distance)
