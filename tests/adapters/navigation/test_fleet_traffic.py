@@ -5,10 +5,11 @@ import pytest
 
 import adapters.navigation.fleet_traffic as fleet_traffic
 import cosim
-from adapters.navigation.fleet_traffic import MOVE, STAND, FleetTraffic
+from adapters.navigation.fleet_traffic import CLEARANCE_M, MOVE, STAND, FleetTraffic
 from models.errors import ModelError
 from models.navigation.costmap import CostmapParams, StaticCostmap
 from models.navigation.lanes import TWO_WAY
+from models.navigation.roadmap import build_roadmap
 from models.occupancy import OccupancyGrid
 
 
@@ -69,3 +70,40 @@ def test_a_fleet_with_more_robots_than_places_is_refused_naming_the_key():
     positions = np.full((20, 2), 1.5)
     with pytest.raises(ModelError, match=r"robots\.count"):
         FleetTraffic(static, lanes, positions, 0.33)
+
+
+def test_a_robot_waiting_on_its_goals_place_keeps_the_free_places_it_needs():
+    occupancy = np.zeros((60, 60), dtype=np.int8)  # 6 m x 6 m
+    occupancy[0, :] = occupancy[-1, :] = occupancy[:, 0] = occupancy[:, -1] = 100
+    static = StaticCostmap.from_grid(OccupancyGrid(0.1, (0.0, 0.0), occupancy), CostmapParams(0.33))
+    lanes = np.full(static.cost.shape, TWO_WAY, dtype=np.uint8)
+    traffic = FleetTraffic(static, lanes, np.array([[1.5, 1.5], [3.0, 3.0], [4.5, 4.5]]), 0.33)
+    roadmap = build_roadmap(
+        static.distance_m, static.origin_xy_m, 0.1, traffic.spacing_m, 0.33 + CLEARANCE_M
+    )
+    traffic.roadmap = roadmap  # two-way everywhere: only the places matter here
+    xy = roadmap.xy
+    p = int(roadmap.nearest_k(np.array([[2.5, 2.5]]), 1)[0, 0])
+    east, north = int(roadmap.neighbours[p, 0]), int(roadmap.neighbours[p, 2])
+    corner = int(roadmap.neighbours[east, 2])
+    west_of_north = int(roadmap.neighbours[north, 1])
+    beyond = int(roadmap.neighbours[corner, 0])
+    # robot 0 stands on its goal's place, its goal between four places; robot 1 drives off
+    # the corner place (still holding it); robot 2 would step through the north place
+    goal = xy[p] + 0.4
+    poses = np.zeros((3, 3))
+    poses[0, :2] = xy[p]
+    poses[1, :2] = xy[corner] + (0.3, 0.0)
+    poses[2, :2] = xy[west_of_north]
+    traffic.node[:] = [p, beyond, west_of_north]
+    traffic.mode[:] = [STAND, MOVE, STAND]
+    traffic.came_from[:] = [p, corner, west_of_north]
+    traffic.held = [[p], [corner], [west_of_north]]
+    traffic.aim[:] = xy[traffic.node]
+    assert set(traffic._touched(goal, p)) == {p, east, north, corner}
+    traffic.set_goal(0, goal, p, 0)
+    traffic.set_goal(2, xy[north] + (1.6, 0.0), int(roadmap.neighbours[beyond, 2]), 0)
+    active = np.array([True, False, True])
+    traffic.step(poses, active, np.zeros(3, dtype=np.int64), 1)
+    assert traffic.mode[0] == STAND  # waits for the corner place
+    assert traffic.node[2] != north  # kept for robot 0's approach
