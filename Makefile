@@ -74,7 +74,7 @@ study-mapping: setup  ## map sharing: bandwidth x loss x share mode, 5 seeds x 3
 study-mapping-reduced: setup  ## map sharing reduced to 12 runs x 120 s
 	$(call STUDY,map_sharing_reduced)
 
-study-traffic: setup  ## traffic policies 'none', 'lanes', 'pibt' x 25/50 robots, 3 seeds x 300 s (about 2 min)
+study-traffic: setup  ## traffic policies 'none', 'lanes', 'pibt' x 25/50 robots, 10 seeds x 300 s (about 7 min)
 	$(call STUDY,traffic)
 
 study-humans: setup  ## robots among 0-20 SUMO-driven workers, 5 seeds x 300 s (about 3 min)
