@@ -226,20 +226,8 @@ class Recorder:
         counts = self.counts
         for status in statuses:
             counts[status] += 1
-        others = n - dsts.count(src)
-        self.network_messages += others
-        self.network_bytes += others * nbytes
-        if not self.record_messages:
-            return
-        self._t_sent.extend([t_sent_ns] * n)
-        self._t_recv.extend([-1 if t.t_recv_ns is None else t.t_recv_ns for t in transfers])
-        self._src.extend([src] * n)
-        self._dst.extend(dsts)
-        self._topic.extend([topic] * n)
-        self._bytes.extend([nbytes] * n)
-        self._status.extend(statuses)
-        if len(self._src) >= _FLUSH_ROWS:
-            self._flush()
+        t_recv = [-1 if t.t_recv_ns is None else t.t_recv_ns for t in transfers]
+        self._rows(t_sent_ns, src, topic, nbytes, dsts, t_recv, statuses)
 
     def on_all_delivered(
         self,
@@ -260,18 +248,32 @@ class Recorder:
             return
         delivered = DeliveryStatus.DELIVERED
         self.counts[delivered] += n
+        self._rows(t_sent_ns, src, topic, nbytes, dsts, [t_recv_ns] * n, [delivered] * n)
+
+    def _rows(
+        self,
+        t_sent_ns: int,
+        src: HostId,
+        topic: str,
+        nbytes: int,
+        dsts: Sequence[HostId],
+        t_recv_ns: list[int],
+        statuses: list[DeliveryStatus],
+    ) -> None:
+        """Network counts and (when recording) the rows of one transmission's copies."""
+        n = len(dsts)
         others = n - dsts.count(src)
         self.network_messages += others
         self.network_bytes += others * nbytes
         if not self.record_messages:
             return
         self._t_sent.extend([t_sent_ns] * n)
-        self._t_recv.extend([t_recv_ns] * n)
+        self._t_recv.extend(t_recv_ns)
         self._src.extend([src] * n)
         self._dst.extend(dsts)
         self._topic.extend([topic] * n)
         self._bytes.extend([nbytes] * n)
-        self._status.extend([delivered] * n)
+        self._status.extend(statuses)
         if len(self._src) >= _FLUSH_ROWS:
             self._flush()
 
