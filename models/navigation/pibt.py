@@ -74,7 +74,13 @@ class Pibt:
         For a robot whose plan left ``other`` with no way on (a robot waiting to drive off
         its place onto its goal, whose neighbour can only leave through its place):
         ``other`` may now ask ``robot`` to make way. Their claims are dropped first.
+
+        Raises:
+            ValueError: unless both are planned to stay where they stand (a robot that
+                leaves may have a follower, whose step would no longer hold).
         """
+        if any(self.nxt.get(r) != self.at[r] for r in (robot, other)):
+            raise ValueError(f"robots {robot} and {other} must both be planned to stay")
         for node, owner in list(self.claimed.items()):
             if owner in (robot, other):
                 del self.claimed[node]

@@ -1,6 +1,7 @@
 """One PIBT step: claims, making way, following, and what no step may do."""
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -83,6 +84,14 @@ def test_a_robot_lets_through_one_whose_only_way_on_leads_over_its_node():
     assert step.claimed == {1: 1, 2: 0}
 
 
+def test_only_robots_planned_to_stay_can_let_each_other_through():
+    step = Pibt({0: 0, 1: 2}, _grid(3, 1), _towards({0: 1, 1: 2}, 3), set())
+    step.move(0)  # moves on to node 1
+    step.move(1)
+    with pytest.raises(ValueError, match="stay"):
+        step.let_through(1, 0)
+
+
 @settings(max_examples=300, deadline=None)
 @given(
     width=st.integers(2, 6),
@@ -92,6 +101,7 @@ def test_a_robot_lets_through_one_whose_only_way_on_leads_over_its_node():
 def test_no_step_shares_a_node_swaps_jumps_enters_a_held_node_or_follows_round_a_cycle(
     width, height, data
 ):
+    """Also when, after the step, one robot staying lets another staying through."""
     nodes = width * height
     blocked = frozenset(data.draw(st.sets(st.integers(0, nodes - 1), max_size=nodes // 3)))
     free = [u for u in range(nodes) if u not in blocked]
@@ -103,7 +113,15 @@ def test_no_step_shares_a_node_swaps_jumps_enters_a_held_node_or_follows_round_a
     order = data.draw(st.permutations(range(len(places))))
     neighbours = _grid(width, height, blocked)
     at = dict(enumerate(places))
-    nxt = _step(at, neighbours, _towards(goals, width), held, list(order))
+    step = Pibt(at, neighbours, _towards(goals, width), set(held))
+    for robot in order:
+        if robot not in step.nxt:
+            step.move(robot)
+    staying = [r for r in range(len(places)) if step.nxt[r] == at[r]]
+    if len(staying) >= 2 and data.draw(st.booleans()):
+        robot, other = data.draw(st.permutations(staying))[:2]
+        step.let_through(robot, other)
+    nxt = step.nxt
 
     assert set(nxt) == set(at)
     assert len(set(nxt.values())) == len(nxt)  # one robot per node
