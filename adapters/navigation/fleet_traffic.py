@@ -189,11 +189,7 @@ class FleetTraffic:
 
     def way_left(self, i: int, xy: FloatArray) -> float:
         """Robot ``i``'s way (m) from ``xy`` to its goal along the places (inf if none)."""
-        active = np.zeros(len(self.node), dtype=bool)
-        active[i] = True
-        points = np.zeros((len(self.node), 2))
-        points[i] = xy
-        return float(self._remaining(points, active)[i])
+        return float(self._ways(np.asarray(xy, dtype=float)[None], np.array([i]))[0])
 
     def end_goal(self, i: int) -> None:
         """Robot ``i``'s goal is reached, dropped or cancelled: it settles on its place."""
@@ -393,24 +389,32 @@ class FleetTraffic:
                 pibt.claim(i, u)
 
     def _remaining(self, xy: FloatArray, active: BoolArray) -> FloatArray:
-        """Way left to each goal (m): to the next place, along the places, to the goal."""
-        rm = self.roadmap
+        """Way left to each goal (m), 0 for robots without one (see :meth:`_ways`)."""
         out = np.zeros(len(xy))
         going = np.flatnonzero(active & (self.goal_node >= 0))
-        if not len(going):
-            return out
-        goal_node = self.goal_node[going]
+        if len(going):
+            out[going] = self._ways(xy[going], going)
+        return out
+
+    def _ways(self, xy: FloatArray, robots: IntArray) -> FloatArray:
+        """Way left (m) of ``robots`` standing at ``xy`` (a row each).
+
+        To the next place, along the places, to the goal; straight to the goal while
+        approaching it.
+        """
+        rm = self.roadmap
+        goal_node = self.goal_node[robots]
         hops = np.array(
-            [self._hops(int(g))[u] for g, u in zip(goal_node, self.node[going], strict=True)],
+            [self._hops(int(g))[u] for g, u in zip(goal_node, self.node[robots], strict=True)],
             dtype=float,
         )
         hops[hops == UNREACHABLE] = np.inf
-        goal = self.goal[going]
+        goal = self.goal[robots]
         along = (
-            np.hypot(*(xy[going] - self.aim[going]).T)
+            np.hypot(*(xy - self.aim[robots]).T)
             + hops * rm.spacing_m
             + np.hypot(*(rm.xy[goal_node] - goal).T)
         )
-        approaching = self.mode[going] == APPROACH
-        out[going] = np.where(approaching, np.hypot(*(xy[going] - goal).T), along)
-        return out
+        approaching = self.mode[robots] == APPROACH
+        ways: FloatArray = np.where(approaching, np.hypot(*(xy - goal).T), along)
+        return ways

@@ -300,13 +300,10 @@ class NavigationAdapter:
             self._drop(run, i, "unreachable", where.value)
             return
         # path_length_ratio's yardstick (shortest way on the true map from the true position)
-        # counts only on arrival. A robot planning on the static layer from exactly its true
-        # position finds a route there (its first plan's "cleared" try) if and only if the
-        # yardstick exists, so it measures it on arrival (1,000 robots: half the searches
-        # at t = 0 were yardsticks of goals not reached in the run); others need it now.
-        # With the fleet's places, a goal reached from a place of the robot's own component
-        # is reachable: its yardstick waits for the arrival too (1,000 robots: 1.4 s of
-        # searches at t = 0), and the way accepted is the way along the places.
+        # counts only on arrival. With the fleet's places, a goal reached from a place of
+        # the robot's own component is reachable: its yardstick waits for the arrival
+        # (1,000 robots: 1.4 s of searches at t = 0), and the way accepted is the way along
+        # the places.
         places = self.places
         if places is not None:
             place = places.goal_place(i, self.goal[i])
@@ -318,6 +315,10 @@ class NavigationAdapter:
             places.set_goal(i, self.goal[i], place, now)
             self._begin(run, i, now, math.nan, places.way_left(i, self.pose[i, :2]))
             return
+        # A robot planning on the static layer from exactly its true position finds a route
+        # there (its first plan's "cleared" try) if and only if the yardstick exists, so it
+        # measures it on arrival (1,000 robots: half the searches at t = 0 were yardsticks
+        # of goals not reached in the run); others need it now.
         deferred = not self.mapping and np.array_equal(self.pose[i, :2], truth)
         shortest = math.nan if deferred else self._yardstick(i)
         if not deferred and not math.isfinite(shortest):

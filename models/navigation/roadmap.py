@@ -193,9 +193,7 @@ def one_way(
         origin: ``map`` position of the lower-left corner of lane cell (0, 0) (m).
         res: lane cell size (m).
     """
-    ix = np.floor((roadmap.xy[:, 0] - origin[0]) / res).astype(np.int64)
-    iy = np.floor((roadmap.xy[:, 1] - origin[1]) / res).astype(np.int64)
-    lane = lanes[iy, ix]
+    lane = _lanes_at(roadmap.xy, lanes, origin, res)
     against = {0: WEST, 1: EAST, 2: SOUTH, 3: NORTH}  # step k is against this lane
     neighbours = roadmap.neighbours.copy()
     for k in range(4):
@@ -262,9 +260,7 @@ def one_way_floor(
     """
     if not len(roadmap):
         return roadmap
-    ix = np.floor((roadmap.xy[:, 0] - origin[0]) / res).astype(np.int64)
-    iy = np.floor((roadmap.xy[:, 1] - origin[1]) / res).astype(np.int64)
-    lane = lanes[iy, ix]
+    lane = _lanes_at(roadmap.xy, lanes, origin, res)
     col = np.rint((roadmap.xy[:, 0] - roadmap.xy[:, 0].min()) / roadmap.spacing_m).astype(np.int64)
     row = np.rint((roadmap.xy[:, 1] - roadmap.xy[:, 1].min()) / roadmap.spacing_m).astype(np.int64)
     along = {0: (row, EAST), 1: (row, WEST), 2: (col, NORTH), 3: (col, SOUTH)}
@@ -304,6 +300,16 @@ def one_way_floor(
         neighbours = np.where(restore, roadmap.neighbours, neighbours)
         directed = Roadmap(roadmap.xy, neighbours, roadmap.spacing_m)
     return directed
+
+
+def _lanes_at(
+    xy: FloatArray, lanes: UInt8Array, origin: tuple[float, float], res: float
+) -> UInt8Array:
+    """The lane direction of the cell under each of (m, 2) points (m)."""
+    ix = np.floor((xy[:, 0] - origin[0]) / res).astype(np.int64)
+    iy = np.floor((xy[:, 1] - origin[1]) / res).astype(np.int64)
+    found: UInt8Array = lanes[iy, ix]
+    return found
 
 
 def _stray(before: IntArray, after: IntArray) -> BoolArray:
