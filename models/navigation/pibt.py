@@ -33,7 +33,8 @@ class Pibt:
         neighbours: (m, 4) neighbouring nodes of every node, -1 where there is none.
         rank: ``rank(robot, node)``: sort key of a candidate node for a robot (lower is
             better: hops to its goal first).
-        held: nodes no one may move to this step (held by robots between two nodes).
+        held: nodes held by robots between two nodes, and by whom (-1: by several): no
+            one else may move to them this step; their holder may go back.
 
     Attributes:
         claimed: nodes claimed for the next step (node -> robot).
@@ -45,7 +46,7 @@ class Pibt:
         at: Mapping[int, int],
         neighbours: IntArray,
         rank: Callable[[int, int], tuple[float, ...]],
-        held: set[int],
+        held: Mapping[int, int],
     ) -> None:
         self.at = at
         self.neighbours = neighbours
@@ -55,9 +56,9 @@ class Pibt:
         self.nxt: dict[int, int] = {}
         self.standing = {v: r for r, v in at.items()}
 
-    def free(self, node: int) -> bool:
-        """Whether no one holds or has claimed ``node``."""
-        return node not in self.claimed and node not in self.held
+    def free(self, node: int, robot: int = -1) -> bool:
+        """Whether no one (but ``robot``) holds ``node``, and no one has claimed it."""
+        return node not in self.claimed and self.held.get(node, robot) == robot
 
     def claim(self, robot: int, node: int) -> None:
         """Claim ``node`` for ``robot`` outside the search (a final approach)."""
@@ -109,7 +110,7 @@ class Pibt:
         options = [here] + [int(u) for u in self.neighbours[here] if u >= 0]
         options.sort(key=lambda u: self.rank(robot, u))
         for u in options:
-            if not self.free(u):
+            if not self.free(u, robot):
                 continue
             if asker is not None and u == self.at.get(asker):
                 continue  # no swaps

@@ -3,7 +3,10 @@
 Robots that the fleet manager moves between reserved places drive the straight line
 between them (the reservation covers that line and nothing else), as grid-bound
 warehouse robots do: turn in place towards the next point, then drive at the speed from
-which they can still stop on it. A moving thing in the strip ahead stops them.
+which they can still stop on it. Any lidar hit in the strip ahead stops them: a protective
+field in the robot's own frame, as on industrial AGVs' safety laser scanners, which holds
+whatever the robot's pose estimate (a robot localizing on its own map may be 0.4 m off its
+place, and a robot parked for long is in its neighbours' maps, not "moving").
 """
 
 from __future__ import annotations
@@ -27,6 +30,28 @@ STOP_MARGIN_M = 0.02
 """Free distance kept to a moving thing ahead beyond the braking distance (m)."""
 
 
+def in_robot_frames(
+    points: FloatArray, start: IntArray, poses: FloatArray
+) -> tuple[IntArray, FloatArray, FloatArray]:
+    """Lidar hits in their owners' ``base_link`` frames.
+
+    Args:
+        points: (k, 2) hits in ``map`` (m), CSR-packed by robot.
+        start: (n + 1,) CSR offsets: robot ``i`` owns ``points[start[i]:start[i + 1]]``.
+        poses: (n, 3) robot poses ``x y yaw`` in ``map`` (m, rad).
+
+    Returns:
+        ``(owner, ahead, side)``: (k,) the robot that saw each hit, and the hit's x
+        (forward) and y (left) in that robot's ``base_link`` (m).
+    """
+    owner = np.repeat(np.arange(len(start) - 1), np.diff(start))
+    pose = poses[owner]
+    dx = points[:, 0] - pose[:, 0]
+    dy = points[:, 1] - pose[:, 1]
+    cos_yaw, sin_yaw = np.cos(pose[:, 2]), np.sin(pose[:, 2])
+    return owner, cos_yaw * dx + sin_yaw * dy, cos_yaw * dy - sin_yaw * dx
+
+
 def place_drive(
     poses: FloatArray,
     points: FloatArray,
@@ -43,9 +68,9 @@ def place_drive(
         points: (n, 2) point each robot drives to, in ``map`` (m).
         limits: drive limits.
         radius_m: footprint radius (m).
-        owner: (k,) robot that saw each moving thing.
-        ahead: (k,) the thing's x in its owner's ``base_link`` (m).
-        side: (k,) the thing's y in its owner's ``base_link`` (m).
+        owner: (k,) robot that saw each lidar hit.
+        ahead: (k,) the hit's x in its owner's ``base_link`` (m).
+        side: (k,) the hit's y in its owner's ``base_link`` (m).
 
     Returns:
         Forward speeds (m/s) and yaw rates (rad/s), (n,) each.
@@ -63,11 +88,13 @@ def place_drive(
     v = np.where(np.abs(error) > TURN_FIRST_RAD, 0.0, v * np.cos(error))
     v = np.where(there, 0.0, v)
     w = np.where(there, 0.0, w)
-    # slow for anything moving in the strip ahead short of the point, to stop before it
+    # slow for any hit in the strip ahead short of the point, to stop before it
     strip = (ahead > 0) & (np.abs(side) < radius_m + STRIP_MARGIN_M)
     if strip.any():
+        # how far the footprint (a disc) goes straight on before it touches the hit
+        reach = np.sqrt(np.maximum(radius_m**2 - side[strip] ** 2, 0.0))
         free = np.full(len(poses), np.inf)
-        np.minimum.at(free, owner[strip], ahead[strip] - radius_m)
+        np.minimum.at(free, owner[strip], ahead[strip] - reach)
         room = np.maximum(free - STOP_MARGIN_M, 0.0)  # how far it may go
         short = room < distance
         limit = np.minimum(np.sqrt(limits.max_accel_mps2 * room), FINAL_GAIN * room)

@@ -34,7 +34,7 @@ def _towards(goals: dict[int, int], width: int):
 
 
 def _step(at, neighbours, rank, held=frozenset(), order=None):
-    step = Pibt(at, neighbours, rank, set(held))
+    step = Pibt(at, neighbours, rank, dict.fromkeys(held, -1))
     for robot in order if order is not None else sorted(at):
         if robot not in step.nxt:
             step.move(robot)
@@ -63,6 +63,17 @@ def test_a_held_node_is_never_entered():
     assert nxt == {0: 0}
 
 
+def test_a_held_node_is_entered_only_by_the_one_robot_that_holds_it():
+    # robot 0 on node 1, asked to make way by robot 1 on node 2, can only go back to node 0:
+    # its own body still covers it, so it may; held by robot 5, or by several, it may not
+    corridor = _grid(3, 1)
+    rank = _towards({0: 2, 1: 0}, 3)
+    for holder, moved in ((0, {0: 0, 1: 1}), (5, {0: 1, 1: 2}), (-1, {0: 1, 1: 2})):
+        step = Pibt({0: 1, 1: 2}, corridor, rank, {0: holder})
+        step.move(1)
+        assert step.nxt == moved
+
+
 def test_a_robot_does_not_move_onto_the_node_of_a_robot_planned_before_it():
     # robot 0 goes first and moves off node 1 of its own accord; robot 1 waits a step
     nxt = _step({0: 1, 1: 0}, _grid(3, 1), _towards({0: 2, 1: 2}, 3), order=[0, 1])
@@ -74,7 +85,7 @@ def test_a_robot_lets_through_one_whose_only_way_on_leads_over_its_node():
     # (its goal) and claimed to stay; robot 1 on node 0 can only go on through node 1
     neighbours = np.array([[1, -1, -1, -1], [2, -1, 3, -1], [-1, -1, -1, -1], [-1, -1, -1, 1]])
     rank = _towards({0: 1, 1: 2}, 10)
-    step = Pibt({0: 1, 1: 0}, neighbours, rank, set())
+    step = Pibt({0: 1, 1: 0}, neighbours, rank, {})
     step.move(0)
     step.move(1)
     assert step.nxt == {0: 1, 1: 0}  # stuck: robot 0 stays, robot 1 cannot move
@@ -85,7 +96,7 @@ def test_a_robot_lets_through_one_whose_only_way_on_leads_over_its_node():
 
 
 def test_only_robots_planned_to_stay_can_let_each_other_through():
-    step = Pibt({0: 0, 1: 2}, _grid(3, 1), _towards({0: 1, 1: 2}, 3), set())
+    step = Pibt({0: 0, 1: 2}, _grid(3, 1), _towards({0: 1, 1: 2}, 3), {})
     step.move(0)  # moves on to node 1
     step.move(1)
     with pytest.raises(ValueError, match="stay"):
@@ -108,12 +119,14 @@ def test_no_step_shares_a_node_swaps_jumps_enters_a_held_node_or_follows_round_a
     if not free:
         return
     places = data.draw(st.lists(st.sampled_from(free), unique=True, min_size=1))
-    held = set(data.draw(st.sets(st.sampled_from(free)))) - set(places)
+    held_nodes = set(data.draw(st.sets(st.sampled_from(free)))) - set(places)
+    # each held by one of the robots (its body still covers it), or by others (-1)
+    held = {u: data.draw(st.integers(-1, len(places) - 1)) for u in sorted(held_nodes)}
     goals = {r: data.draw(st.sampled_from(free)) for r in range(len(places))}
     order = data.draw(st.permutations(range(len(places))))
     neighbours = _grid(width, height, blocked)
     at = dict(enumerate(places))
-    step = Pibt(at, neighbours, _towards(goals, width), set(held))
+    step = Pibt(at, neighbours, _towards(goals, width), held)
     for robot in order:
         if robot not in step.nxt:
             step.move(robot)
@@ -128,7 +141,7 @@ def test_no_step_shares_a_node_swaps_jumps_enters_a_held_node_or_follows_round_a
     standing = {v: r for r, v in at.items()}
     for r, v in nxt.items():
         assert v == at[r] or v in neighbours[at[r]]  # stays or steps to a neighbour
-        assert v not in held
+        assert held.get(v, r) == r  # a held node only by its holder
         other = standing.get(v)
         if other is not None and other != r:
             assert nxt[other] != at[other]  # follows a robot that leaves...
