@@ -78,7 +78,7 @@ def per_scan_costs(repeat: int) -> Result:
 
 def fleet50_mapping(repeat: int) -> Result:
     """fleet50 with navigation, with and without mapping (drift 0.02), 30 s, same run."""
-    base = {"scenario.duration_s": 30.0}
+    base = {"scenario.duration_s": 30.0, "navigation.traffic": "none"}  # every robot plans
     plain = cosim.load_scenario("fleet50", base)
     mapped = cosim.load_scenario(
         "fleet50", {**base, "mapping.enabled": True, "odometry.drift": 0.02}

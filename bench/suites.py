@@ -265,13 +265,23 @@ def _shares(scenario: cosim.Scenario, breakdown: dict[str, tuple[str, str]]) -> 
     return {"summary": result.summary, "shares": shares}
 
 
+EVERY_ROBOT_PLANS = {"navigation.traffic": "none"}
+"""fleet50's robots each planning with A* and following with DWA (the paper's Nav2 role), not
+moved by the preset's fleet manager: what the navigation figures and breakdowns measure."""
+
+
 def fleet50_navigation(repeat: int) -> Result:
-    """fleet50 preset (navigation to random goals): real-time factor and where time goes."""
-    scenario = cosim.load_scenario("fleet50", {"scenario.duration_s": 60.0})
+    """fleet50, every robot planning (A* + DWA) to random goals: real-time factor, where time
+    goes; and the preset as it comes (its fleet manager, traffic 'pibt') in the same run."""
+    scenario = cosim.load_scenario("fleet50", {"scenario.duration_s": 60.0, **EVERY_ROBOT_PLANS})
     runs = _rtf_runs(scenario, repeat)
+    preset = _rtf_runs(cosim.load_scenario("fleet50", {"scenario.duration_s": 60.0}), repeat)
     profiled = _shares(scenario.with_duration(30.0), BREAKDOWN)
     return {
         **runs,
+        "overrides": EVERY_ROBOT_PLANS,
+        "preset_real_time_factor_median": preset["real_time_factor_median"],
+        "preset_collisions_last": preset["collisions_last"],
         "arrivals_last": profiled["summary"]["arrivals"],
         "breakdown_share_of_wall_time": profiled["shares"],
         "breakdown_note": "cProfile shares of a 30 s run (profiling slows the run ~30 %)",
@@ -279,6 +289,7 @@ def fleet50_navigation(repeat: int) -> Result:
 
 
 FULL_STACK = {
+    **EVERY_ROBOT_PLANS,
     "robots.driver": "tasks",
     "tasks.initial": 50,
     "assignment.protocol": "distributed_simplex",
@@ -286,7 +297,8 @@ FULL_STACK = {
     "odometry.drift": 0.02,
 }
 """fleet50 with the whole stack: 50 tasks assigned by distributed simplex (a new one for each
-done), every robot mapping as it drives on drifting odometry, navigation on its own map."""
+done), every robot mapping as it drives on drifting odometry, navigation on its own map
+(every robot planning: the preset's fleet manager needs poses better than its mapping gives)."""
 
 FULL_STACK_BREAKDOWN = {
     "task assignment rounds (protocol, broadcasts)": ("adapters/assignment/dta.py", "_round_of"),

@@ -300,7 +300,7 @@ class FleetTraffic:
         poses: FloatArray,
         points: FloatArray,
         settle: tuple[FloatArray, FloatArray, BoolArray] | None,
-        hits: tuple[IntArray, FloatArray, FloatArray],
+        free_m: FloatArray,
         limits: DriveLimits,
     ) -> tuple[FloatArray, FloatArray]:
         """Speed and yaw-rate commands: straight from place to place.
@@ -309,7 +309,7 @@ class FleetTraffic:
         place from off it (at the start, after a goal) take the local controller's speed
         and yaw rate from ``settle`` (needed when any robot is :attr:`settling`).
         """
-        v, w = place_drive(poses, points, limits, self.radius_m, *hits)
+        v, w = place_drive(poses, points, limits, free_m)
         if settle is None:
             return v, w
         settling = self.settling

@@ -59,7 +59,7 @@ from models.mapping.se2 import compose
 from models.navigation.costmap import CostmapParams, StaticCostmap
 from models.navigation.dwa import DwaParams, dwa_batch
 from models.navigation.follow import PathBook
-from models.navigation.place_drive import in_robot_frames
+from models.navigation.place_drive import free_ahead
 from models.navigation.planner import (
     GoalStatus,
     goal_status,
@@ -431,8 +431,8 @@ class NavigationAdapter:
         settle = None
         if places.settling.any():
             settle = self._local_control(aims, aims, points, start, moving, now_ns)
-        hits = in_robot_frames(points, start, self.pose)
-        v, w = places.commands(self.pose, aims, settle, hits, self.limits)
+        free = free_ahead(points, start, self.pose, places.radius_m)
+        v, w = places.commands(self.pose, aims, settle, free, self.limits)
         self._track_progress(run, now_ns, remaining)
         self.remaining = remaining
         self._publish(run, np.where(lost, 0.0, v), np.where(lost, 0.0, w))

@@ -11,6 +11,9 @@ place, and a robot parked for long is in its neighbours' maps, not "moving").
 
 from __future__ import annotations
 
+from typing import Any
+
+import numba
 import numpy as np
 
 from models.arrays import FloatArray, IntArray
@@ -24,42 +27,59 @@ FINAL_GAIN = 2.0
 """Speed limit per metre left to the point (1/s)."""
 THERE_M = 0.02
 """A robot this close to its point stands still (m)."""
-STRIP_MARGIN_M = 0.0
-"""Half-width of the strip checked ahead, beyond the footprint radius (m)."""
 STOP_MARGIN_M = 0.02
-"""Free distance kept to a moving thing ahead beyond the braking distance (m)."""
+"""Free distance kept to a lidar hit ahead beyond the braking distance (m)."""
 
 
-def in_robot_frames(
-    points: FloatArray, start: IntArray, poses: FloatArray
-) -> tuple[IntArray, FloatArray, FloatArray]:
-    """Lidar hits in their owners' ``base_link`` frames.
+def free_ahead(
+    points: FloatArray, start: IntArray, poses: FloatArray, radius_m: float
+) -> FloatArray:
+    """How far each robot's footprint can go straight on before it touches a lidar hit.
 
     Args:
         points: (k, 2) hits in ``map`` (m), CSR-packed by robot.
         start: (n + 1,) CSR offsets: robot ``i`` owns ``points[start[i]:start[i + 1]]``.
         poses: (n, 3) robot poses ``x y yaw`` in ``map`` (m, rad).
+        radius_m: footprint radius (m).
 
     Returns:
-        ``(owner, ahead, side)``: (k,) the robot that saw each hit, and the hit's x
-        (forward) and y (left) in that robot's ``base_link`` (m).
+        (n,) distance (m) the disc of ``radius_m`` travels along the robot's heading
+        until it first touches one of its hits; inf when none lies in that strip ahead.
     """
-    owner = np.repeat(np.arange(len(start) - 1), np.diff(start))
-    pose = poses[owner]
-    dx = points[:, 0] - pose[:, 0]
-    dy = points[:, 1] - pose[:, 1]
-    cos_yaw, sin_yaw = np.cos(pose[:, 2]), np.sin(pose[:, 2])
-    return owner, cos_yaw * dx + sin_yaw * dy, cos_yaw * dy - sin_yaw * dx
+    free = np.full(len(poses), np.inf)
+    _free_ahead(
+        np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2),
+        np.ascontiguousarray(start, dtype=np.int64),
+        np.ascontiguousarray(poses, dtype=np.float64),
+        float(radius_m),
+        free,
+    )
+    return free
+
+
+def _free_ahead_py(
+    points: FloatArray, start: IntArray, poses: FloatArray, radius_m: float, free: FloatArray
+) -> None:
+    for i in range(poses.shape[0]):
+        cos_yaw, sin_yaw = np.cos(poses[i, 2]), np.sin(poses[i, 2])
+        for p in range(start[i], start[i + 1]):
+            dx, dy = points[p, 0] - poses[i, 0], points[p, 1] - poses[i, 1]
+            ahead = cos_yaw * dx + sin_yaw * dy
+            side = cos_yaw * dy - sin_yaw * dx
+            if ahead > 0.0 and abs(side) < radius_m:
+                # the disc touches the hit once its centre is this far on
+                touch = ahead - np.sqrt(radius_m * radius_m - side * side)
+                free[i] = min(free[i], touch)
+
+
+_free_ahead: Any = numba.njit(cache=True)(_free_ahead_py)
 
 
 def place_drive(
     poses: FloatArray,
     points: FloatArray,
     limits: DriveLimits,
-    radius_m: float,
-    owner: IntArray,
-    ahead: FloatArray,
-    side: FloatArray,
+    free_m: FloatArray,
 ) -> tuple[FloatArray, FloatArray]:
     """Speed and yaw-rate commands that take every robot straight to its point.
 
@@ -67,10 +87,8 @@ def place_drive(
         poses: (n, 3) robot poses ``x y yaw`` in ``map`` (m, rad).
         points: (n, 2) point each robot drives to, in ``map`` (m).
         limits: drive limits.
-        radius_m: footprint radius (m).
-        owner: (k,) robot that saw each lidar hit.
-        ahead: (k,) the hit's x in its owner's ``base_link`` (m).
-        side: (k,) the hit's y in its owner's ``base_link`` (m).
+        free_m: (n,) how far each robot can go straight on before it touches a lidar hit
+            (m, :func:`free_ahead`).
 
     Returns:
         Forward speeds (m/s) and yaw rates (rad/s), (n,) each.
@@ -89,14 +107,7 @@ def place_drive(
     v = np.where(there, 0.0, v)
     w = np.where(there, 0.0, w)
     # slow for any hit in the strip ahead short of the point, to stop before it
-    strip = (ahead > 0) & (np.abs(side) < radius_m + STRIP_MARGIN_M)
-    if strip.any():
-        # how far the footprint (a disc) goes straight on before it touches the hit
-        reach = np.sqrt(np.maximum(radius_m**2 - side[strip] ** 2, 0.0))
-        free = np.full(len(poses), np.inf)
-        np.minimum.at(free, owner[strip], ahead[strip] - reach)
-        room = np.maximum(free - STOP_MARGIN_M, 0.0)  # how far it may go
-        short = room < distance
-        limit = np.minimum(np.sqrt(limits.max_accel_mps2 * room), FINAL_GAIN * room)
-        v = np.where(short, np.minimum(v, limit), v)
+    room = np.maximum(free_m - STOP_MARGIN_M, 0.0)  # how far it may go
+    limit = np.minimum(np.sqrt(limits.max_accel_mps2 * room), FINAL_GAIN * room)
+    v = np.where(room < distance, np.minimum(v, limit), v)
     return v, w

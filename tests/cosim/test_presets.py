@@ -17,3 +17,9 @@ def test_the_paper_presets_have_the_papers_fleets_and_rooms():
     assert cosim.load_scenario("fleet50").world.size_m == (30.0, 30.0)
     assert cosim.load_scenario("warehouse-rows").world.layout == "all_rows"
     assert cosim.load_scenario("lab-room").world.size_m == (4.0, 8.0)
+
+
+def test_fleet50_comes_with_the_fleet_manager_and_the_others_let_each_robot_plan():
+    assert cosim.load_scenario("fleet50").navigation.traffic == "pibt"
+    others = [name for name in preset_names() if name != "fleet50"]
+    assert all(cosim.load_scenario(name).navigation.traffic == "none" for name in others)

@@ -5,6 +5,7 @@ import cosim
 from models.navigation.landmarks import Landmarks
 
 FLEET = {
+    "navigation.traffic": "none",  # every robot plans (fleet50's fleet manager plans none)
     "robots.count": 6,
     "scenario.duration_s": 6.0,
     "record.bag": "none",
