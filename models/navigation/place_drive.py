@@ -6,7 +6,9 @@ warehouse robots do: turn in place towards the next point, then drive at the spe
 which they can still stop on it. Any lidar hit in the strip ahead stops them: a protective
 field in the robot's own frame, as on industrial AGVs' safety laser scanners, which holds
 whatever the robot's pose estimate (a robot localizing on its own map may be 0.4 m off its
-place, and a robot parked for long is in its neighbours' maps, not "moving").
+place, and a robot parked for long is in its neighbours' maps, not "moving"). The strip is
+the footprint's width: 3 cm wider, robots in fleet50 (20 seeds x 300 s, traffic "pibt") kept
+37-40 mm apart instead of 7-15 mm but gave up 8 goals instead of 5, with as many reached.
 """
 
 from __future__ import annotations
