@@ -2,10 +2,11 @@
 
 Until tasks exist, each robot gets a stream of goals: a free cell of the inflated static
 map, drawn from the robot's own random stream, in the same connected free region as the
-robot; a new one when the previous is reached, found unreachable, or reported stuck (as a
-fleet manager would re-target a stalled robot). With ``navigation.goals`` the goals are
-that series instead, in order and round again (robot ``i`` starts at goal ``i``), as the
-paper's Scenario 2 sends its robot through a series of goal poses.
+robot; a new one when the previous is reached or reported stuck (as a fleet manager would
+re-target a stalled robot), and a second after one is found unreachable. With
+``navigation.goals`` the goals are that series instead, in order and round again (robot
+``i`` starts at goal ``i``), as the paper's Scenario 2 sends its robot through a series of
+goal poses.
 """
 
 from __future__ import annotations
@@ -22,11 +23,14 @@ from cosim.bus import Envelope
 from cosim.errors import ConfigError
 from cosim.hosts import HostId
 from cosim.messages import Message, NavGoal, NavStatus
+from cosim.timebase import s_to_ns
 from models.kinematics import FleetState
 from models.navigation.costmap import StaticCostmap
 
 GOAL_CLEARANCE_M = 0.3
 """Free space kept around a goal beyond the footprint (m)."""
+RETRY_S = 1.0
+"""After a goal found unreachable, the next goal goes out this much later (s)."""
 
 
 class GoalsAdapter:
@@ -62,6 +66,7 @@ class GoalsAdapter:
                     f"points inside the room [0, {width:g}] x [0, {height:g}] m"
                 )
         self.rngs = [run.rng.stream(f"goals/{n}") for n in self.names]
+        self.retry_ns = s_to_ns(RETRY_S)
         self.next_id = np.zeros(len(self.names), dtype=np.int64)
         self.sent = 0
         for name in self.names:
@@ -78,8 +83,20 @@ class GoalsAdapter:
         def on_status(message: Message, _envelope: Envelope) -> None:
             assert isinstance(message, NavStatus)
             current = message.goal_id == self.next_id[i] - 1
-            if current and message.state in ("arrived", "unreachable", "stuck"):
+            if current and message.state in ("arrived", "stuck"):
                 self._send(run, i)
+            elif current and message.state == "unreachable":
+                # the next goal a moment later: a robot whose goals all are unreachable
+                # (one stranded in a pocket) would otherwise be sent goal after goal within
+                # one instant, each answered at once, without end
+                run.kernel.at(run.kernel.now_ns + self.retry_ns, retry(int(self.next_id[i])))
+
+        def retry(sent: int) -> Callable[[], None]:
+            def send() -> None:
+                if self.next_id[i] == sent:  # no goal went out meanwhile
+                    self._send(run, i)
+
+            return send
 
         return on_status
 
