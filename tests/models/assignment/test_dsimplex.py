@@ -31,6 +31,17 @@ def _diameter(n: int, edges: list[tuple[int, int]]) -> int:
     return graph_diameter(_adjacency(n, edges))
 
 
+def _network(seed, make_lp, make_graph):
+    """Seed's problem, each robot's neighbours in a graph of GRAPHS, and the diameter."""
+    problem = make_lp(seed)
+    n = len(problem.robots)
+    edges = make_graph(GRAPHS[seed % 3], n, np.random.default_rng(seed + 10**6))
+    neighbours = {
+        i: [j for a, b in edges for i2, j in ((a, b), (b, a)) if i2 == i] for i in range(n)
+    }
+    return problem, neighbours, _diameter(n, edges)
+
+
 @pytest.mark.parametrize("chunk", range(5))
 def test_every_agent_ends_with_the_central_optimum_on_random_instances(chunk, make_lp, make_graph):
     for seed in range(100 * chunk, 100 * chunk + 100):
@@ -183,13 +194,8 @@ def test_the_agent_objective_counts_only_columns_at_one():
 def test_bases_resent_as_the_same_objects_give_the_rounds_fresh_copies_give(
     seed, make_lp, make_graph
 ):
-    problem = make_lp(seed)
+    problem, neighbours, bound = _network(seed, make_lp, make_graph)
     n = len(problem.robots)
-    edges = make_graph(GRAPHS[seed % 3], n, np.random.default_rng(seed + 10**6))
-    neighbours = {
-        i: [j for a, b in edges for i2, j in ((a, b), (b, a)) if i2 == i] for i in range(n)
-    }
-    bound = _diameter(n, edges)
     shared = [agent_for(problem, [i], bound) for i in range(n)]
     fresh = [agent_for(problem, [i], bound) for i in range(n)]
     sent: list[list] = [[] for _ in range(n)]  # what each shared agent sends, kept until it changes
@@ -211,13 +217,8 @@ def test_bases_resent_as_the_same_objects_give_the_rounds_fresh_copies_give(
 def test_bases_received_with_their_column_sets_give_the_rounds_plain_lists_give(
     seed, make_lp, make_graph
 ):
-    problem = make_lp(seed)
+    problem, neighbours, bound = _network(seed, make_lp, make_graph)
     n = len(problem.robots)
-    edges = make_graph(GRAPHS[seed % 3], n, np.random.default_rng(seed + 10**6))
-    neighbours = {
-        i: [j for a, b in edges for i2, j in ((a, b), (b, a)) if i2 == i] for i in range(n)
-    }
-    bound = _diameter(n, edges)
     keyed = [agent_for(problem, [i], bound) for i in range(n)]
     plain = [agent_for(problem, [i], bound) for i in range(n)]
     sent: list[SharedBasis | None] = [None] * n  # kept until the basis changes
