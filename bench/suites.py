@@ -298,7 +298,8 @@ FULL_STACK = {
 }
 """fleet50 with the whole stack: 50 tasks assigned by distributed simplex (a new one for each
 done), every robot mapping as it drives on drifting odometry, navigation on its own map
-(every robot planning: the preset's fleet manager needs poses better than its mapping gives)."""
+(every robot planning: the preset's fleet manager refuses robots localizing on their own
+maps)."""
 
 FULL_STACK_BREAKDOWN = {
     "task assignment rounds (protocol, broadcasts)": ("adapters/assignment/dta.py", "_round_of"),

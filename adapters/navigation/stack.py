@@ -28,7 +28,7 @@ import numpy as np
 from adapters.fleet.motion import drive_limits
 from adapters.mapping.geometry import map_geometry, unknown_grid
 from adapters.naming import topic
-from adapters.navigation.fleet_traffic import FleetTraffic
+from adapters.navigation.fleet_traffic import FleetTraffic, check_localization
 from adapters.navigation.layers import StaticLayer, StaticLayers, lanes_on
 from adapters.navigation.localization import MeasuredPoses
 from adapters.navigation.planning import GlobalPlanning
@@ -124,6 +124,9 @@ class NavigationAdapter:
                 ground_truth_grid(run.service(Warehouse), cfg.resolution_m),
                 LANE_WIDTH_M,
             )
+        self.measured = MeasuredPoses(run, self.names)
+        """Robots localizing by motion capture (or their own reported pose)."""
+        check_localization(run.scenario, self.measured.tracked)
         self.places: FleetTraffic | None = None
         if cfg.traffic == "pibt":  # the fleet manager moves every robot place by place
             truth = ground_truth_grid(run.service(Warehouse), cfg.resolution_m)
@@ -134,8 +137,6 @@ class NavigationAdapter:
                 radius,
             )
         run.provide(self.static)
-        self.measured = MeasuredPoses(run, self.names)
-        """Robots localizing by motion capture (or their own reported pose)."""
         self.correction = [(0.0, 0.0, 0.0)] * len(self.names)
         """Per robot ``map -> odom`` from its mapping (identity without mapping)."""
         self.limits = drive_limits(run)

@@ -360,3 +360,15 @@ def test_the_run_summary_leads_with_tasks_and_rounds_to_meaningful_digits(tmp_pa
     assert "goals reached" not in second
     clearance = re.search(r"(-?[\d.]+) m smallest clearance", second).group(1)
     assert len(clearance.split(".")[1]) == 2
+
+
+def test_the_fleet_managers_preset_with_mapping_exits_2_naming_both_ways_out(tmp_path):
+    done = cosim_cli(
+        "run", "fleet50", "--set", "mapping.enabled=true", "--out", str(tmp_path / "out")
+    )
+    assert done.returncode == 2
+    assert done.stderr.count("\n") == 1, done.stderr
+    assert "[navigation] traffic = 'pibt' with [mapping] enabled = true" in done.stderr
+    assert "navigation.traffic = 'none'" in done.stderr
+    assert "Traceback" not in done.stderr
+    assert not (tmp_path / "out").exists()

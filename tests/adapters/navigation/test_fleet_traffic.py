@@ -1,5 +1,7 @@
 """``navigation.traffic = "pibt"``: the fleet manager moving robots place by place."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -70,6 +72,45 @@ def test_a_fleet_with_more_robots_than_places_is_refused_naming_the_key():
     positions = np.full((20, 2), 1.5)
     with pytest.raises(ModelError, match=r"robots\.count"):
         FleetTraffic(static, lanes, positions, 0.33)
+
+
+@pytest.mark.parametrize(
+    ("override", "named"),
+    [
+        ({"mapping.enabled": True}, r"\[mapping\] enabled = true"),
+        ({"odometry.drift": 0.02}, r"\[odometry\] drift = 0.02"),
+        (
+            {"mapping.enabled": True, "mocap.source": "simulated", "mocap.robots": ["robot_1"]},
+            "3 of 4",
+        ),
+    ],
+)
+def test_the_fleet_manager_refuses_robots_that_cannot_localize_to_within_its_gap(override, named):
+    scenario = cosim.load_scenario("fleet50", {**override, "robots.count": 4})
+    with pytest.raises(cosim.ConfigError) as refused:
+        cosim.run(scenario.with_duration(1.0))
+    message = str(refused.value)
+    assert "preset fleet50: [navigation] traffic = 'pibt'" in message
+    assert re.search(named, message), message
+    assert "navigation.traffic = 'none'" in message and "mocap.source = 'simulated'" in message
+
+
+def test_robots_that_map_drive_on_the_fleet_managers_places_when_motion_capture_tracks_them():
+    scenario = cosim.load_scenario(
+        "fleet50",
+        {
+            "robots.count": 12,
+            "scenario.duration_s": 40.0,
+            "mapping.enabled": True,
+            "odometry.drift": 0.02,
+            "mocap.source": "simulated",
+            "record.bag": "none",
+        },
+    )
+    summary = cosim.run(scenario).summary
+    assert summary["collisions"] == 0
+    assert summary["arrivals"] >= 5
+    assert summary["goals_missed"] == 0
 
 
 def test_a_robot_waiting_on_its_goals_place_keeps_the_free_places_it_needs():
