@@ -20,9 +20,13 @@ priority order that is not in :attr:`Pibt.nxt` yet.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Collection, Mapping
 
 from models.arrays import IntArray
+
+DETOUR = 5
+"""Steps longer than its best way that a robot asked to make way behind a robot driving off
+will not take (see ``leaving`` in :class:`Pibt`)."""
 
 
 class Pibt:
@@ -35,6 +39,12 @@ class Pibt:
             better: hops to its goal first).
         held: nodes held by robots between two nodes, and by whom (-1: by several): no
             one else may move to them this step; their holder may go back.
+        leaving: held nodes whose holder is driving off them (free in a moment). A robot
+            asked to make way whose best node is one of them does not take a way longer
+            than five steps more (the first element of ``rank``; round the block is
+            20-30 steps in fleet50): it follows the robot leaving instead, and the asker
+            tries its next choice. (One step more, robots kept in line behind robots
+            leaving gave up 6 goals in fleet50, 20 seeds x 300 s, against 2 without.)
 
     Attributes:
         claimed: nodes claimed for the next step (node -> robot).
@@ -47,11 +57,13 @@ class Pibt:
         neighbours: IntArray,
         rank: Callable[[int, int], tuple[float, ...]],
         held: Mapping[int, int],
+        leaving: Collection[int] = (),
     ) -> None:
         self.at = at
         self.neighbours = neighbours
         self.rank = rank
         self.held = held
+        self.leaving = leaving
         self.claimed: dict[int, int] = {}
         self.nxt: dict[int, int] = {}
         self.standing = {v: r for r, v in at.items()}
@@ -109,9 +121,13 @@ class Pibt:
         here = self.at[robot]
         options = [here] + [int(u) for u in self.neighbours[here] if u >= 0]
         options.sort(key=lambda u: self.rank(robot, u))
+        # asked to make way while the robot ahead drives off its best node: no detour
+        best = self.rank(robot, options[0])[0] if options[0] in self.leaving else None
         for u in options:
             if not self.free(u, robot):
                 continue
+            if asker is not None and best is not None and self.rank(robot, u)[0] > best + DETOUR:
+                break
             if asker is not None and u == self.at.get(asker):
                 continue  # no swaps
             other = self.standing.get(u)

@@ -148,3 +148,40 @@ def test_a_robot_waiting_on_its_goals_place_keeps_the_free_places_it_needs():
     traffic.step(poses, active, np.zeros(3, dtype=np.int64), 1)
     assert traffic.mode[0] == STAND  # waits for the corner place
     assert traffic.node[2] != north  # kept for robot 0's approach
+
+
+@pytest.mark.parametrize("returning", [True, False])
+def test_a_robot_that_let_another_through_off_its_goals_place_keeps_its_places_coming_back(
+    returning,
+):
+    occupancy = np.zeros((60, 60), dtype=np.int8)  # 6 m x 6 m
+    occupancy[0, :] = occupancy[-1, :] = occupancy[:, 0] = occupancy[:, -1] = 100
+    static = StaticCostmap.from_grid(OccupancyGrid(0.1, (0.0, 0.0), occupancy), CostmapParams(0.33))
+    lanes = np.full(static.cost.shape, TWO_WAY, dtype=np.uint8)
+    traffic = FleetTraffic(static, lanes, np.array([[1.5, 1.5], [4.5, 4.5]]), 0.33)
+    roadmap = build_roadmap(
+        static.distance_m, static.origin_xy_m, 0.1, traffic.spacing_m, 0.33 + CLEARANCE_M
+    )
+    traffic.roadmap = roadmap  # two-way everywhere: only the places matter here
+    xy = roadmap.xy
+    p = int(roadmap.nearest_k(np.array([[2.5, 2.5]]), 1)[0, 0])
+    east, west, north = (int(roadmap.neighbours[p, k]) for k in (0, 1, 2))
+    further_east = int(roadmap.neighbours[east, 0])
+    # robot 0 made way from its goal's place onto the place north of it; robot 1, east of
+    # the place east of it, drives west past the goal
+    goal = xy[p] + (0.4, 0.0)
+    assert set(traffic._touched(goal, p)) == {p, east}
+    poses = np.zeros((2, 3))
+    poses[0, :2], poses[1, :2] = xy[north], xy[further_east]
+    poses[1, 2] = np.pi
+    traffic.node[:] = [north, further_east]
+    traffic.came_from[:] = [p, int(roadmap.neighbours[further_east, 0])]
+    traffic.mode[:] = STAND
+    traffic.held = [[north], [further_east]]
+    traffic.aim[:] = xy[traffic.node]
+    traffic.set_goal(0, goal, p, 0)
+    traffic.set_goal(1, xy[west], west, 0)
+    traffic.returning[0] = returning
+    traffic.step(poses, np.array([True, True]), np.zeros(2, dtype=np.int64), 1)
+    assert traffic.node[0] == p  # back to its goal's place
+    assert (traffic.node[1] != east) == returning  # kept for robot 0's approach

@@ -126,7 +126,8 @@ def test_no_step_shares_a_node_swaps_jumps_enters_a_held_node_or_follows_round_a
     order = data.draw(st.permutations(range(len(places))))
     neighbours = _grid(width, height, blocked)
     at = dict(enumerate(places))
-    step = Pibt(at, neighbours, _towards(goals, width), held)
+    leaving = data.draw(st.sets(st.sampled_from(sorted(held_nodes)))) if held_nodes else set()
+    step = Pibt(at, neighbours, _towards(goals, width), held, leaving)
     for robot in order:
         if robot not in step.nxt:
             step.move(robot)
@@ -154,3 +155,24 @@ def test_no_step_shares_a_node_swaps_jumps_enters_a_held_node_or_follows_round_a
             assert r not in seen
             seen.add(r)
             r = standing[nxt[r]]
+
+
+def _queue_with_a_side_loop() -> tuple[np.ndarray, dict[int, int]]:
+    """Nodes 0 - 1 - 2 - 3 in a line, and node 4 off node 1: from 4, 20 steps to node 3."""
+    neighbours = np.full((5, 4), -1, dtype=np.int64)
+    for u, vs in {0: [1], 1: [0, 2, 4], 2: [1, 3], 3: [2], 4: [1]}.items():
+        neighbours[u, : len(vs)] = vs
+    return neighbours, {0: 3, 1: 2, 2: 1, 3: 0, 4: 20}
+
+
+@pytest.mark.parametrize(("leaving", "expected"), [({2}, {0: 0, 1: 1}), (set(), {0: 1, 1: 4})])
+def test_a_robot_asked_to_make_way_follows_the_robot_ahead_leaving_rather_than_go_round(
+    leaving, expected
+):
+    neighbours, steps = _queue_with_a_side_loop()
+    # robot 0 (first) behind robot 1, both for node 3; a robot driving on still holds node 2
+    step = Pibt({0: 0, 1: 1}, neighbours, lambda _r, u: (steps[u], u), {2: 9}, leaving)
+    step.move(0)
+    if 1 not in step.nxt:
+        step.move(1)
+    assert step.nxt == expected
