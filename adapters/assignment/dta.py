@@ -2,7 +2,9 @@
 
 Every robot hears the task source's :class:`~cosim.messages.TaskSet` (an *epoch*: the open
 tasks), computes its own costs from its own pose, and runs ``assignment.protocol`` with
-its neighbours over the network, one round every ``assignment.period_ms``. Once its
+its neighbours over the network, one round every ``assignment.period_ms`` (a robot whose
+protocol has halted skips the round until it hears from a neighbour or its state is due
+to be sent again, as a halted agent of distributed simplex does nothing). Once its
 protocol has decided, a robot with a task claims it (a broadcast :class:`TaskClaim`,
 repeated while it holds it) and drives there through its navigation; at the task it asks
 the task source for the right to serve (granted to one robot only), dwells
@@ -277,6 +279,13 @@ class DtaAdapter:
             return
         inbox, robot.inbox = robot.inbox, []
         was_decided = protocol.decided
+        if (
+            was_decided
+            and robot.acted
+            and not inbox
+            and now_ns - robot.last_broadcast_ns < self.rebroadcast_ns
+        ):
+            return  # halted, nothing heard, nothing to send again yet: the round is idle
         message, changed = protocol.round(inbox, now_ns)
         send = message is not None and (
             changed or not was_decided or now_ns - robot.last_broadcast_ns >= self.rebroadcast_ns

@@ -8,6 +8,7 @@ import pandas as pd
 import pytest
 
 import cosim
+from adapters.assignment.protocols import SimplexProtocol
 from cosim.adapter import RunContext
 from cosim.assembly import adapter_names
 from cosim.kernel import Stage
@@ -200,3 +201,26 @@ def test_with_independent_round_timers_latency_below_one_period_still_delays_con
 
     assert convergence("aligned", 5.0) == convergence("aligned", 50.0)
     assert convergence("independent", 50.0) > convergence("independent", 5.0) + 0.02
+
+
+def test_a_halted_robot_runs_a_round_only_when_it_hears_something_or_must_send_again(
+    monkeypatch,
+):
+    calls: list[tuple[str, int, bool, bool]] = []
+    round_of = SimplexProtocol.round
+
+    def recorded(self, inbox, now_ns):
+        calls.append((self.name, now_ns, self.decided, bool(inbox)))
+        return round_of(self, inbox, now_ns)
+
+    monkeypatch.setattr(SimplexProtocol, "round", recorded)
+    result = _run(**{"scenario.duration_s": 40.0})
+    _check_exactly_once(result)
+    rounds = pd.DataFrame(calls, columns=["robot", "t_ns", "halted", "heard"])
+    idle = rounds[rounds["halted"] & ~rounds["heard"]]
+    assert not idle.empty  # halted robots still send their state again now and then
+    period_ns, again_ns = s_to_ns(0.1), s_to_ns(1.0)  # assignment.period_ms, rebroadcast_s
+    for _robot, times in idle.groupby("robot")["t_ns"]:
+        assert (times.diff().dropna() >= again_ns - period_ns).all()
+    # far fewer rounds than timer ticks: 4 robots x 10 Hz x 40 s
+    assert len(rounds) < 0.5 * 4 * 10 * 40
