@@ -111,6 +111,10 @@ class AdapterType(Protocol):
     Attributes:
         name: the registered name.
         requires: names of adapters that must be constructed (and started) before.
+
+    A class may also declare a static ``check_scenario(scenario)`` that raises
+    :class:`~cosim.errors.ConfigError` for combinations of sections it cannot run
+    (:func:`cosim.assembly.check_scenario` calls it before anything is built).
     """
 
     name: ClassVar[str]

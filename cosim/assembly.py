@@ -58,6 +58,22 @@ def adapter_names(scenario: Scenario, *, recording: bool = False) -> list[str]:
     return names
 
 
+def check_scenario(
+    scenario: Scenario, *, registry: AdapterRegistry | None = None, recording: bool = False
+) -> None:
+    """Refuse combinations of sections that cannot work, before anything is built.
+
+    Every adapter the scenario runs may declare ``check_scenario(scenario)`` (a static
+    method raising :class:`~cosim.errors.ConfigError`); studies call this for each of their
+    combinations before the first run, :func:`assemble` before building the world.
+    """
+    registry = registry or AdapterRegistry.from_entry_points()
+    for name in registry.resolve(adapter_names(scenario, recording=recording)):
+        check = getattr(registry.get(name), "check_scenario", None)
+        if check is not None:
+            check(scenario)
+
+
 def needs_realtime(scenario: Scenario) -> bool:
     """Whether the scenario talks to the real world (physical robots, live mocap)."""
     return bool(scenario.physical.robots) or scenario.mocap.source in ("motioncapture", "ros2")
@@ -93,6 +109,7 @@ def assemble(
     """
     registry = registry or AdapterRegistry.from_entry_points()
     if names is None:
+        check_scenario(scenario, registry=registry, recording=recording)
         names = adapter_names(scenario, recording=recording)
     ordered = registry.resolve(names)
     if needs_realtime(scenario):

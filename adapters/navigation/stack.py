@@ -27,7 +27,8 @@ import numpy as np
 
 from adapters.fleet.motion import drive_limits
 from adapters.mapping.geometry import map_geometry, unknown_grid
-from adapters.naming import topic
+from adapters.mocap.tracking import tracked_robots
+from adapters.naming import robot_name, topic
 from adapters.navigation.fleet_traffic import FleetTraffic, check_localization
 from adapters.navigation.layers import StaticLayer, StaticLayers, lanes_on
 from adapters.navigation.localization import MeasuredPoses
@@ -52,6 +53,7 @@ from cosim.messages import (
     Twist,
 )
 from cosim.messages import OccupancyGrid as GridMessage
+from cosim.scenario.model import Scenario
 from cosim.timebase import NS_PER_S, period_ns, s_to_ns
 from models.kinematics import FleetState
 from models.lidar import ScanGeometry
@@ -91,6 +93,16 @@ class NavigationAdapter:
     name: ClassVar[str] = "navigation"
     requires: ClassVar[tuple[str, ...]] = ("world", "fleet", "lidar")
 
+    @staticmethod
+    def check_scenario(scenario: Scenario) -> None:
+        """Refuse the fleet manager for robots that cannot localize well enough for it.
+
+        See :func:`~adapters.navigation.fleet_traffic.check_localization`.
+        """
+        names = [robot_name(i) for i in range(scenario.robots.count)]
+        tracked = np.isin(names, tracked_robots(scenario, names))
+        check_localization(scenario, tracked)
+
     def __init__(self, run: RunContext) -> None:
         cfg = run.scenario.navigation
         if run.scenario.lidar.beams == 0:
@@ -126,7 +138,6 @@ class NavigationAdapter:
             )
         self.measured = MeasuredPoses(run, self.names)
         """Robots localizing by motion capture (or their own reported pose)."""
-        check_localization(run.scenario, self.measured.tracked)
         self.places: FleetTraffic | None = None
         if cfg.traffic == "pibt":  # the fleet manager moves every robot place by place
             truth = ground_truth_grid(run.service(Warehouse), cfg.resolution_m)

@@ -28,8 +28,10 @@ heatmaps = ["tasks_per_min"]       # optional: x by facet, a panel per hue value
 loglog = ["wall_us_per_robot_s"]  # optional: also drawn on log-log axes (x values > 0)
 ```
 
-Every combination is loaded as a scenario before the study starts, so a bad key or value in
-any of them is reported (file, key, value, expectation) and nothing runs.
+Every combination is loaded as a scenario before the study starts, and its adapters check
+the sections they need together (:func:`cosim.assembly.check_scenario`), so a bad key or
+value, or a combination that cannot run, in any of them is reported (file, key, value,
+expectation) and nothing runs.
 """
 
 from __future__ import annotations
@@ -39,11 +41,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from cosim.assembly import adapter_names
+from cosim.assembly import adapter_names, check_scenario
 from cosim.errors import ConfigError
+from cosim.registry import AdapterRegistry
 from cosim.runner import execute
 from cosim.scenario import load_scenario
-from cosim.scenario.fields import show_name, suggest
+from cosim.scenario.fields import show_name, show_value, suggest
 from cosim.scenario.loader import preset_names
 from cosim.scenario.tomlfile import read_toml_file
 
@@ -335,13 +338,17 @@ def _check_timeseries(path: Path, entries: Any, tables: tuple[str, ...]) -> None
 
 
 def _validate_combinations(spec: StudySpec) -> None:
-    """Load every combination as a scenario: a bad key or value stops the study here.
+    """Load and check every combination: what it cannot run stops the study here.
+
+    A bad key or value, or a combination an adapter refuses
+    (:func:`cosim.assembly.check_scenario`), is reported before any run.
 
     When the study keeps named tables, one scenario per distinct set of adapters is also run
     for a millisecond (adapters create some tables only when they finish), so a table no run
     would produce is reported now rather than by every run.
     """
     origin = f"{spec.path} [grid/overrides/cases]"
+    registry = AdapterRegistry.from_entry_points()
     named = [t for t in spec.tables if t != "*"]
     checked: set[tuple[str, ...]] = set()
     have: set[str] = set()
@@ -350,6 +357,11 @@ def _validate_combinations(spec: StudySpec) -> None:
         if spec.duration_s is not None:
             overrides["scenario.duration_s"] = spec.duration_s
         scenario = load_scenario(spec.scenario, overrides, override_origin=origin)
+        try:
+            check_scenario(scenario, registry=registry)
+        except ConfigError as error:
+            shown = ", ".join(f"{k} = {show_value(v)}" for k, v in combination.items())
+            raise ConfigError(f"{origin} ({shown}): {error}") from None
         if named and (names := tuple(adapter_names(scenario))) not in checked:
             checked.add(names)
             have |= set(execute(scenario.with_duration(0.001)).tables)

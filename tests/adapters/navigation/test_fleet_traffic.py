@@ -4,10 +4,13 @@ import re
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import adapters.navigation.fleet_traffic as fleet_traffic
 import cosim
 from adapters.navigation.fleet_traffic import CLEARANCE_M, MOVE, STAND, FleetTraffic
+from cosim.assembly import check_scenario
 from models.errors import ModelError
 from models.navigation.costmap import CostmapParams, StaticCostmap
 from models.navigation.lanes import TWO_WAY
@@ -185,3 +188,31 @@ def test_a_robot_that_let_another_through_off_its_goals_place_keeps_its_places_c
     traffic.step(poses, np.array([True, True]), np.zeros(2, dtype=np.int64), 1)
     assert traffic.node[0] == p  # back to its goal's place
     assert (traffic.node[1] != east) == returning  # kept for robot 0's approach
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    traffic=st.sampled_from(["none", "lanes", "pibt"]),
+    mapping=st.booleans(),
+    drift=st.one_of(st.just(0.0), st.floats(0.0, 1.0)),
+    tracked=st.one_of(st.none(), st.lists(st.integers(1, 4), unique=True)),
+)
+def test_the_fleet_manager_is_refused_exactly_when_an_untracked_robot_localizes_badly(
+    traffic, mapping, drift, tracked
+):
+    overrides = {
+        "navigation.traffic": traffic,
+        "mapping.enabled": mapping,
+        "odometry.drift": drift,
+        "robots.count": 4,
+    }
+    if tracked is not None:  # tracked by simulated motion capture ([] = every robot)
+        overrides |= {"mocap.source": "simulated", "mocap.robots": [f"robot_{i}" for i in tracked]}
+    scenario = cosim.load_scenario("fleet50", overrides)
+    everyone = tracked is not None and len(tracked) in (0, 4)
+    refused = traffic == "pibt" and not everyone and (mapping or drift > 0)
+    if not refused:
+        check_scenario(scenario)
+        return
+    with pytest.raises(cosim.ConfigError, match=r"\[navigation\] traffic = 'pibt' with \["):
+        check_scenario(scenario)

@@ -112,3 +112,18 @@ def test_the_command_line_exits_2_with_one_line_on_a_bad_loglog(tmp_path):
     assert "loglog = 'wall_time_s': expected a list of metric names" in done.stderr
     assert done.stderr.count("\n") == 1 and str(path) in done.stderr
     assert not (tmp_path / "out").exists()
+
+
+def test_a_combination_an_adapter_cannot_run_is_refused_before_any_run_naming_it(tmp_path):
+    path = tmp_path / "traffic_mapping.toml"
+    path.write_text(
+        '[study]\nname = "t"\nscenario = "fleet50"\nseeds = 1\nduration_s = 2\n\n'
+        '[grid]\n"navigation.traffic" = ["none", "pibt"]\n\n'
+        '[overrides]\n"mapping.enabled" = true\n"robots.count" = 4\n'
+    )
+    with pytest.raises(ConfigError) as refused:
+        load_study(path)
+    message = str(refused.value)
+    assert message.startswith(f"{path} [grid/overrides/cases] (")
+    assert "navigation.traffic = 'pibt'" in message
+    assert "[navigation] traffic = 'pibt' with [mapping] enabled = true" in message
