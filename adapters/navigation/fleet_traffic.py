@@ -281,10 +281,15 @@ class FleetTraffic:
         # held places and their holders (-1: several); a robot may go back to a place
         # only its own body still covers (it made way, or turns back)
         held: dict[int, int] = {}
+        leaving: set[int] = set()  # places robots driving on have left (free once clear)
+        mode = self.mode.tolist()
         for i in range(len(xy)):
-            mine = self.held[i] if self.mode[i] == STAND else [*self.held[i], int(self.node[i])]
+            node = int(self.node[i])
+            mine = self.held[i] if mode[i] == STAND else [*self.held[i], node]
             for u in mine:
                 held[u] = i if held.get(u, i) == i else -1
+            if mode[i] == MOVE:
+                leaving.update(u for u in self.held[i] if u != node)
         at = {int(i): int(self.node[i]) for i in standing}
         occupied = set(at.values())
         for u in occupied:
@@ -301,13 +306,6 @@ class FleetTraffic:
             turn = float(u != here and float(np.dot(heading, rm.xy[u] - rm.xy[here])) <= 0.0)
             return (hops, float(u in occupied and u != here), turn, float(u))
 
-        # places robots driving on have just left (free once their body is clear)
-        leaving = {
-            u
-            for i in np.flatnonzero(self.mode == MOVE).tolist()
-            for u in self.held[i]
-            if u != self.node[i]
-        }
         pibt = Pibt(at, rm.neighbours, rank, held, leaving)
         self._keep_for_returning(pibt)
         order = self._order(standing, active, progress_ns, now_ns)

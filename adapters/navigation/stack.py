@@ -136,8 +136,6 @@ class NavigationAdapter:
                 ground_truth_grid(run.service(Warehouse), cfg.resolution_m),
                 LANE_WIDTH_M,
             )
-        self.measured = MeasuredPoses(run, self.names)
-        """Robots localizing by motion capture (or their own reported pose)."""
         self.places: FleetTraffic | None = None
         if cfg.traffic == "pibt":  # the fleet manager moves every robot place by place
             truth = ground_truth_grid(run.service(Warehouse), cfg.resolution_m)
@@ -148,6 +146,8 @@ class NavigationAdapter:
                 radius,
             )
         run.provide(self.static)
+        self.measured = MeasuredPoses(run, self.names)
+        """Robots localizing by motion capture (or their own reported pose)."""
         self.correction = [(0.0, 0.0, 0.0)] * len(self.names)
         """Per robot ``map -> odom`` from its mapping (identity without mapping)."""
         self.limits = drive_limits(run)
