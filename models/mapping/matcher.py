@@ -241,6 +241,25 @@ def _refine_py(
     return best
 
 
+def _add4_py(
+    acc: tuple[int, int, int, int], row: Any, x: int, step: int
+) -> tuple[int, int, int, int]:
+    """``acc`` plus ``row`` at ``x``, ``x + step``, ``x + 2 step`` and ``x + 3 step``."""
+    return (
+        acc[0] + int(row[x]),
+        acc[1] + int(row[x + step]),
+        acc[2] + int(row[x + 2 * step]),
+        acc[3] + int(row[x + 3 * step]),
+    )
+
+
+def _put4_py(out: Any, *rows: tuple[int, int, int, int]) -> None:
+    """Add four rows of four sums to ``out[:16]`` (row-major)."""
+    for j in range(4):
+        for k in range(4):
+            out[4 * j + k] += rows[j][k]
+
+
 def _search_py(
     fine: Any,
     coarse: Any,
@@ -282,10 +301,17 @@ def _search_py(
     reach = (blocks - 1) * c
     for a in range(n_rot):
         sums[:] = 0
+        q0 = q1 = q2 = q3 = (0, 0, 0, 0)
         for i in range(n_pts):
             y0i = by[a, i] - n_lin
             x0i = bx[a, i] - n_lin
             if y0i >= 0 and x0i >= 0 and y0i + reach < height and x0i + reach < width:
+                if blocks == 4:  # the default window: 16 running sums in registers (1.6x per match)
+                    q0 = _add4(q0, coarse[y0i], x0i, c)
+                    q1 = _add4(q1, coarse[y0i + c], x0i, c)
+                    q2 = _add4(q2, coarse[y0i + 2 * c], x0i, c)
+                    q3 = _add4(q3, coarse[y0i + 3 * c], x0i, c)
+                    continue
                 for bj in range(blocks):
                     for bi in range(blocks):
                         sums[bj * blocks + bi] += int(coarse[y0i + bj * c, x0i + bi * c])
@@ -303,6 +329,8 @@ def _search_py(
                         cx = 0
                     if 0 <= cx < width:
                         sums[bj * blocks + bi] += int(coarse[cy, cx])
+        if blocks == 4:
+            _put4(sums, q0, q1, q2, q3)
         for k in range(blocks * blocks):
             bounds[a * blocks * blocks + k] = sums[k] / (255.0 * n_pts)
     order = np.argsort(-bounds)
@@ -334,10 +362,18 @@ def _search_py(
         ny = min(c, n_lin + 1 - ky0)
         nx = min(c, n_lin + 1 - kx0)
         block[:, :] = 0
+        whole = c == 4 and ny == 4 and nx == 4
+        q0 = q1 = q2 = q3 = (0, 0, 0, 0)
         for i in range(n_pts):
             y0i = by[a, i] + ky0
             x0i = bx[a, i] + kx0
             if y0i >= 0 and x0i >= 0 and y0i + ny <= height and x0i + nx <= width:
+                if whole:  # as for the bounds: a whole block's sums in registers
+                    q0 = _add4(q0, fine[y0i], x0i, 1)
+                    q1 = _add4(q1, fine[y0i + 1], x0i, 1)
+                    q2 = _add4(q2, fine[y0i + 2], x0i, 1)
+                    q3 = _add4(q3, fine[y0i + 3], x0i, 1)
+                    continue
                 for j in range(ny):
                     for k in range(nx):
                         block[j, k] += int(fine[y0i + j, x0i + k])
@@ -350,6 +386,8 @@ def _search_py(
                     cx = x0i + k
                     if 0 <= cx < width:
                         block[j, k] += int(fine[cy, cx])
+        if whole:
+            _put4(block.ravel(), q0, q1, q2, q3)
         for j in range(ny):
             ky = ky0 + j
             for k in range(nx):
@@ -365,6 +403,8 @@ def _search_py(
     return best_kx, best_ky, best_a, best, evaluated
 
 
+_add4: Any = numba.njit(cache=True, inline="always")(_add4_py)
+_put4: Any = numba.njit(cache=True)(_put4_py)
 _search: Any = numba.njit(cache=True)(_search_py)
 _sample: Any = numba.njit(cache=True)(_sample_py)
 _refine: Any = numba.njit(cache=True)(_refine_py)
