@@ -168,7 +168,13 @@ def _recompute_score_py(
     score[iy, ix] = best
 
 
+def _max4_py(row: Any, x: int) -> int:
+    """The largest of ``row[x:x + 4]``."""
+    return max(max(row[x], row[x + 1]), max(row[x + 2], row[x + 3]))  # type: ignore[no-any-return]
+
+
 def _refresh_coarse_py(score: Any, coarse: Any, iy: int, ix: int, c: int) -> None:
+    """The coarse score of one cell: the largest fine score of the c x c cells from it."""
     height, width = score.shape
     best = 0
     for y in range(iy, min(iy + c, height)):
@@ -233,19 +239,24 @@ def _refresh_scores_py(
                 x = ix + kx
                 if 0 <= x < width and kernel[ky + r, kx + r] > score[y, x]:
                     score[y, x] = kernel[ky + r, kx + r]
-    # coarse cells whose window holds a changed fine cell, each once
-    for f in flips:
-        iy, ix = f // width, f % width
-        for y in range(max(0, iy - r - c + 1), min(height, iy + r + 1)):
-            for x in range(max(0, ix - r - c + 1), min(width, ix + r + 1)):
-                dirty[y, x] |= 2
+    # coarse cells whose window holds a changed fine cell: each refreshed when first met
+    # (every fine score is final by now), then the marks cleared window by window
     for f in flips:
         iy, ix = f // width, f % width
         for y in range(max(0, iy - r - c + 1), min(height, iy + r + 1)):
             for x in range(max(0, ix - r - c + 1), min(width, ix + r + 1)):
                 if dirty[y, x] & 2:
+                    continue
+                dirty[y, x] |= 2
+                if c == 4 and y + 4 <= height and x + 4 <= width:  # the default, unrolled
+                    top = max(_max4(score[y], x), _max4(score[y + 1], x))
+                    coarse[y, x] = max(top, _max4(score[y + 2], x), _max4(score[y + 3], x))
+                else:
                     _refresh_coarse(score, coarse, y, x, c)
-                    dirty[y, x] = 0
+    for f in flips:
+        iy, ix = f // width, f % width
+        y0, x0 = max(0, iy - r - c + 1), max(0, ix - r - c + 1)
+        dirty[y0 : min(height, iy + r + 1), x0 : min(width, ix + r + 1)] = 0
     return net
 
 
@@ -289,6 +300,7 @@ traverse: Any = numba.njit(cache=True)(_traverse_py)
 classify: Any = numba.njit(cache=True)(_classify_py)
 apply: Any = numba.njit(cache=True)(_apply_py)
 _recompute_score: Any = numba.njit(cache=True)(_recompute_score_py)
+_max4: Any = numba.njit(cache=True, inline="always")(_max4_py)
 _refresh_coarse: Any = numba.njit(cache=True)(_refresh_coarse_py)
 refresh_scores: Any = numba.njit(cache=True)(_refresh_scores_py)
 rebuild_scores: Any = numba.njit(cache=True)(_rebuild_scores_py)
