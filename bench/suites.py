@@ -310,6 +310,30 @@ FULL_STACK_BREAKDOWN = {
 }
 
 
+LAYERS = {
+    "sensors, physics and bus (wander driver)": {"robots.driver": "wander"},
+    "+ navigation (random goals, every robot planning)": EVERY_ROBOT_PLANS,
+    "+ task assignment (distributed simplex; robots drive to tasks), no mapping": {
+        **FULL_STACK,
+        "mapping.enabled": False,
+        "odometry.drift": 0.0,
+    },
+    "+ mapping on drifting odometry (the full stack)": FULL_STACK,
+}
+"""The full stack built up layer by layer, each row adding to the one before: what each layer
+costs per simulated second, so that the 20x target's budget (50 ms) can be read against it."""
+
+
+def _layer_costs(repeat: int) -> dict[str, float]:
+    """Wall time per simulated second (ms) of each of :data:`LAYERS`, median of ``repeat``."""
+    costs = {}
+    for name, overrides in LAYERS.items():
+        scenario = cosim.load_scenario("fleet50", {"scenario.duration_s": 30.0, **overrides})
+        runs = _rtf_runs(scenario, repeat)
+        costs[name] = round(1000.0 / runs["real_time_factor_median"], 1)
+    return costs
+
+
 def fleet50_full_stack(repeat: int) -> Result:
     """fleet50 with navigation, task assignment and mapping: real-time factor, where time goes."""
     scenario = cosim.load_scenario("fleet50", {"scenario.duration_s": 30.0, **FULL_STACK})
@@ -320,6 +344,9 @@ def fleet50_full_stack(repeat: int) -> Result:
         **runs,
         "overrides": FULL_STACK,
         "target_real_time_factor": 20.0,
+        "target_wall_ms_per_sim_s": 50.0,
+        "layers_wall_ms_per_sim_s": _layer_costs(max(1, repeat - 1)),
+        "layers_note": "each layer adds to the one above it; 30 s runs, same session",
         "arrivals_last": summary.get("arrivals"),
         "path_length_ratio_last": summary.get("path_length_ratio"),
         "breakdown_share_of_wall_time": profiled["shares"],
