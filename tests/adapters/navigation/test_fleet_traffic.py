@@ -153,6 +153,45 @@ def test_a_robot_waiting_on_its_goals_place_keeps_the_free_places_it_needs():
     assert traffic.node[2] != north  # kept for robot 0's approach
 
 
+def test_a_robot_that_landed_on_its_next_place_is_driving_off_the_place_it_still_covers(
+    monkeypatch,
+):
+    """Its old place is ``leaving`` for the step: a robot asked to make way whose best place
+    it is follows it rather than go round the block (fleet50 seed 36 gave a goal up so)."""
+    occupancy = np.zeros((60, 60), dtype=np.int8)  # 6 m x 6 m
+    occupancy[0, :] = occupancy[-1, :] = occupancy[:, 0] = occupancy[:, -1] = 100
+    static = StaticCostmap.from_grid(OccupancyGrid(0.1, (0.0, 0.0), occupancy), CostmapParams(0.33))
+    lanes = np.full(static.cost.shape, TWO_WAY, dtype=np.uint8)
+    traffic = FleetTraffic(static, lanes, np.array([[1.5, 1.5]]), 0.33)
+    roadmap = build_roadmap(
+        static.distance_m, static.origin_xy_m, 0.1, traffic.spacing_m, 0.33 + CLEARANCE_M
+    )
+    traffic.roadmap = roadmap
+    xy = roadmap.xy
+    p = int(roadmap.nearest_k(np.array([[2.5, 2.5]]), 1)[0, 0])
+    q = int(roadmap.neighbours[p, 0])  # east of p
+    seen: list[set[int]] = []
+
+    class Recording(fleet_traffic.Pibt):
+        def __init__(self, *args: object) -> None:
+            super().__init__(*args)  # type: ignore[arg-type]
+            seen.append(set(self.leaving))
+
+    monkeypatch.setattr(fleet_traffic, "Pibt", Recording)
+    # the robot drove from p towards q and is within reach of q, its body still over p
+    along = (xy[q] - xy[p]) / np.hypot(*(xy[q] - xy[p]))
+    poses = np.zeros((1, 3))
+    poses[0, :2] = xy[q] - 0.4 * along
+    traffic.node[:] = [q]
+    traffic.came_from[:] = [p]
+    traffic.mode[:] = [MOVE]
+    traffic.held = [[p]]
+    traffic.aim[:] = xy[traffic.node]
+    traffic.step(poses, np.array([False]), np.zeros(1, dtype=np.int64), 1)
+    assert traffic.mode[0] == STAND and traffic.held[0] == [p]
+    assert seen == [{p}]
+
+
 @pytest.mark.parametrize("returning", [True, False])
 def test_a_robot_that_let_another_through_off_its_goals_place_keeps_its_places_coming_back(
     returning,
