@@ -2,6 +2,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from shapely.geometry import Point, box
 
 from models.collision import CollisionChecker, OtherKind, disc_box_clearance
@@ -107,3 +109,39 @@ def test_empty_candidate_groups_give_empty_clearances():
         assert group.pairs.shape == (0, 2)
         assert group.clearance_m.shape == (0,)
         assert group.clearance_m.dtype == np.float64
+
+
+def _fcl_robot_pairs(checker: CollisionChecker, x, y) -> set[tuple[int, int]]:
+    """The robot pairs of FCL's own self-collision of the grown discs (the reference)."""
+    from models import collision
+
+    checker._place_robots(x, y)
+    found: list[object] = []
+    checker._robots.collide(found, collision._collect)
+    return {tuple(sorted((collision._index(a), collision._index(b)))) for a, b in found}
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    n=st.integers(2, 120),
+    lattice=st.sampled_from([None, 0.5, 0.8, 1.06, 1.2]),
+    same_radius=st.booleans(),
+    seed=st.integers(0, 10_000),
+)
+def test_robot_pairs_from_the_kd_tree_are_fcls_pairs_touching_boxes_included(
+    n, lattice, same_radius, seed
+):
+    """On a lattice of 1.06 m the grown boxes (0.33 + 2 x 0.1 m) touch exactly."""
+    rng = np.random.default_rng(seed)
+    radii = np.full(n, 0.33) if same_radius else rng.uniform(0.15, 0.5, n)
+    checker = CollisionChecker(np.zeros((0, 4)), radii, margin_m=0.1)
+    if lattice is None:
+        x, y = rng.uniform(0.0, 12.0, n), rng.uniform(0.0, 12.0, n)
+    else:
+        side = math.ceil(math.sqrt(n))
+        cells = np.stack(np.meshgrid(np.arange(side), np.arange(side)), -1).reshape(-1, 2)[:n]
+        x, y = cells[:, 0] * lattice + 3.1, cells[:, 1] * lattice + 7.7
+    pairs = checker._robot_pairs(x, y)
+    assert {tuple(p) for p in pairs.tolist()} == _fcl_robot_pairs(checker, x, y)
+    assert np.all(pairs[:, 0] < pairs[:, 1])
+    assert pairs.tolist() == sorted(pairs.tolist())
