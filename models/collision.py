@@ -1,12 +1,13 @@
 """Ground-truth contacts and clearances: python-fcl broad phase, exact planar narrow phase.
 
 Robots and dynamic obstacles (people, forklifts) are vertical discs, walls and shelves
-axis-aligned boxes. FCL's dynamic AABB trees are the broad phase: robots are registered
-with their radius grown by ``margin_m``, so one ``collide`` traversal yields every pair
-whose bounding boxes come closer than the margin. The narrow phase is closed-form
-planar geometry (disc to box, disc to disc), exact and cheaper than FCL's GJK for these
-shapes; a negative clearance is a contact and its magnitude the depth. The smallest
-clearance of pairs farther apart than the margin comes from FCL's ``distance``.
+axis-aligned boxes. Robots are registered with their radius grown by ``margin_m``, so the
+broad phase yields every pair whose bounding boxes come closer than the margin: FCL's
+dynamic AABB trees against boxes and discs, a k-d tree between robots (below). The
+narrow phase is closed-form planar geometry (disc to box, disc to disc), exact and cheaper
+than FCL's GJK for these shapes; a negative clearance is a contact and its magnitude the
+depth. The smallest clearance of pairs farther apart than the margin comes from FCL's
+``distance``.
 
 FCL hands its callbacks fresh Python wrappers that do not expose their geometry, so
 each object's identity rides in the z of its translation (``_Z_STEP_M`` per index);
