@@ -17,10 +17,7 @@ from cosim.messages import AuctionBids, Message, SimplexBasis
 from models.assignment.cbaa import CbaaAgent, scores_from_cost
 from models.assignment.dsimplex import SharedBasis, agent_for
 from models.assignment.greedy import nearest_free
-from models.assignment.problem import AssignmentProblem, Column, ColumnKind
-
-_KINDS = {int(kind): kind for kind in ColumnKind}
-"""Column kinds by wire value: a dict lookup is ~10x cheaper than calling the enum."""
+from models.assignment.problem import AssignmentProblem
 
 
 class BasisDecoder:
@@ -43,7 +40,7 @@ class BasisDecoder:
         known = self._last.get(message.robot)
         if known is not None and known[0] is message.columns:
             return known[1]
-        columns = SharedBasis(Column(_KINDS[k], r, t, c) for k, r, t, c in message.columns)
+        columns = SharedBasis.from_rows(message.columns)
         self._last[message.robot] = (message.columns, columns)
         return columns
 

@@ -3,7 +3,8 @@ import numpy as np
 from adapters.assignment.protocols import BasisDecoder, SimplexProtocol
 from cosim.messages import Message, SimplexBasis
 from models.assignment.dsimplex import SharedBasis
-from models.assignment.problem import AssignmentProblem, Column, ColumnKind
+from models.assignment.problem import AssignmentProblem, Column, ColumnKind, LpShape
+from models.assignment.simplex import columns_of
 
 
 def test_the_simplex_protocol_sends_its_current_basis_every_round():
@@ -33,7 +34,10 @@ def test_a_basis_is_decoded_once_per_sender_until_its_wire_form_changes():
     wire = ((0, 1, 2, 3.5), (1, 0, -1, 1e6))
     first = decoder.decode(SimplexBasis(1, 0, "robot_1", 1, wire))
     assert first == (Column(ColumnKind(0), 1, 2, 3.5), Column(ColumnKind(1), 0, -1, 1e6))
-    assert isinstance(first, SharedBasis) and first.column_set == frozenset(first)
+    assert isinstance(first, SharedBasis)
+    ranks = first.ranked_in(LpShape(2, 3))
+    assert ranks is first.ranked_in(LpShape(2, 3))  # laid out once, for every receiver
+    assert columns_of(LpShape(2, 3), ranks) == list(first)
     # the same wire tuple again (the sender kept it): the same basis, for every receiver
     assert decoder.decode(SimplexBasis(2, 0, "robot_1", 2, wire)) is first
     # an equal tuple that is another object is decoded again, and so is another sender's

@@ -17,8 +17,16 @@ import numpy as np
 import pytest
 
 from models.assignment.dsimplex import SharedBasis, SimplexAgent, agent_for, run_synchronous
-from models.assignment.problem import AssignmentProblem, hungarian, objective
-from models.assignment.simplex import assignment_of, primal, solve
+from models.assignment.problem import (
+    AssignmentProblem,
+    LpShape,
+    hungarian,
+    idle,
+    objective,
+    pair,
+    unserved,
+)
+from models.assignment.simplex import assignment_of, columns_of, primal, solve
 from models.errors import ModelError
 
 GRAPHS = ("complete", "ring", "random")
@@ -242,3 +250,26 @@ def test_bases_received_with_their_column_sets_give_the_rounds_plain_lists_give(
         ]
     assert solves > n  # the sets were merged into solves, not only skipped
     assert all(agent.converged for agent in keyed)
+
+
+def test_a_basis_from_rows_keeps_its_columns_and_lays_them_out_as_they_would_be():
+    shape = LpShape(2, 3)
+    rows = ((0, 1, 2, 3.5), (1, 0, -1, 0.0), (2, -1, 0, 1e6))
+    basis = SharedBasis.from_rows(rows)
+    assert list(basis) == [pair(1, 2, 3.5), idle(0), unserved(0, 1e6)]
+    ranks = basis.ranked_in(shape)
+    assert columns_of(shape, ranks) == list(basis)
+
+
+@pytest.mark.parametrize("rows", [((3, 0, 0, 1.0),), ((0, 0, 0),), (("x", 0, 0, 1.0),)])
+def test_a_basis_from_rows_that_are_not_columns_is_rejected(rows):
+    with pytest.raises(ModelError) as raised:
+        SharedBasis.from_rows(rows)
+    assert raised.value.key == "columns"
+
+
+def test_a_basis_from_rows_out_of_range_is_named_when_it_is_laid_out():
+    basis = SharedBasis.from_rows(((0, 5, 0, 1.0),))
+    with pytest.raises(ModelError, match="indices within") as raised:
+        basis.ranked_in(LpShape(2, 2))
+    assert raised.value.value == pair(5, 0, 1.0)

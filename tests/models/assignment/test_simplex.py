@@ -1,9 +1,12 @@
 from __future__ import annotations
 
+import math
 from fractions import Fraction
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from models.assignment.pivoting import _exact_sign_py
 from models.assignment.problem import (
@@ -17,7 +20,18 @@ from models.assignment.problem import (
     pair,
     unserved,
 )
-from models.assignment.simplex import _layout, assignment_of, lex_simplex, primal, solve
+from models.assignment.simplex import (
+    _layout,
+    assignment_of,
+    columns_of,
+    lex_simplex,
+    primal,
+    ranked,
+    ranked_rows,
+    solve,
+    solve_ranked,
+    union,
+)
 from models.errors import ModelError
 
 
@@ -198,3 +212,87 @@ def test_the_first_column_out_of_range_is_named_whatever_the_layout(bad):
     with pytest.raises(ModelError, match="indices within") as raised:
         _layout(SHAPE, columns, "columns")
     assert raised.value.key == "columns" and raised.value.value == bad
+
+
+_ROWS = st.tuples(
+    st.integers(-2, 4),
+    st.integers(-2, 4),
+    st.integers(-2, 4),
+    st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.integers(-3, 3)),
+)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(_ROWS, min_size=1, max_size=12), st.integers(1, 3), st.integers(1, 3))
+def test_rows_read_as_one_array_rank_as_their_columns_do_or_are_left_to_the_columns(
+    rows, n_robots, n_tasks
+):
+    shape = LpShape(n_robots, n_tasks)
+    fast = ranked_rows(shape, np.array(rows, dtype=np.float64))
+    kinds = {int(k): k for k in ColumnKind}
+    if any(k not in kinds for k, *_ in rows):
+        assert fast is None  # not a kind: the caller refuses the rows
+        return
+    columns = [Column(kinds[k], r, t, float(c)) for k, r, t, c in rows]
+    try:
+        slow = ranked(shape, columns, "columns")
+    except ModelError:
+        assert fast is None  # the column-by-column reading names what is wrong
+        return
+    assert fast is not None
+    assert np.array_equal(fast.rank, slow.rank) and np.array_equal(fast.cost, slow.cost)
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_a_union_holds_each_column_once_in_key_order(seed, make_lp):
+    problem = make_lp(seed)
+    rng = np.random.default_rng(seed)
+    columns = problem.columns()
+    parts = [[columns[k] for k in rng.integers(0, len(columns), 30)] for _ in range(4)]
+    merged = union(problem.shape, [ranked(problem.shape, p, "columns") for p in parts])
+    assert columns_of(problem.shape, merged) == sorted({c for p in parts for c in p})
+
+
+def test_a_union_names_the_first_key_with_two_costs_and_both_costs():
+    a = ranked(SHAPE, [pair(1, 1, 3.0), pair(0, 1, 2.0), idle(0)], "columns")
+    b = ranked(SHAPE, [pair(0, 1, 1.0), pair(1, 1, 0.5), idle(0)], "columns")
+    with pytest.raises(ModelError, match="one cost per column key") as raised:
+        union(SHAPE, [a, b])
+    assert raised.value.value == (pair(0, 1, 1.0), pair(0, 1, 2.0))
+
+
+@pytest.mark.parametrize("cost", [math.inf, -math.inf, math.nan])
+def test_a_column_whose_cost_is_not_finite_is_rejected(cost):
+    with pytest.raises(ModelError, match="a finite cost") as raised:
+        ranked(SHAPE, [idle(0), pair(0, 1, cost)], "columns")
+    assert raised.value.key == "columns"
+
+
+@pytest.mark.parametrize("seed", range(60))
+def test_solves_chained_on_ranked_columns_and_their_tables_equal_solves_on_columns(seed, make_lp):
+    problem = make_lp(seed)
+    rng = np.random.default_rng(seed)
+    shape, columns = problem.shape, problem.columns()
+    basis = problem.start_basis()
+    start = ranked(shape, basis, "start_basis")
+    table = None
+    for _ in range(4):
+        subset = [c for c in columns if rng.random() < 0.5]
+        expected = lex_simplex(shape, subset, basis)
+        candidates = union(shape, [ranked(shape, subset, "columns"), start])
+        got = solve_ranked(shape, candidates, start, table)
+        assert columns_of(shape, got.basis) == expected.basis
+        assert got.pivots == expected.pivots
+        assert np.array_equal(got.table[:, 1:-1], expected.inverse)
+        assert np.array_equal(got.table[:, 0], expected.inverse.sum(axis=1))
+        basis, start, table = expected.basis, got.basis, got.table
+
+
+def test_a_union_in_a_large_lp_sorts_instead_of_marking_every_rank_and_agrees():
+    shape = LpShape(1000, 1000)  # 3 million ranks: too many to mark for a few columns
+    columns = [pair(999, 998, 1.0), idle(3), unserved(5, 9.0), pair(0, 0, 2.0)]
+    parts = [ranked(shape, columns, "columns"), ranked(shape, columns[::-1], "columns")]
+    assert columns_of(shape, union(shape, parts)) == sorted(columns)
+    clash = ranked(shape, [pair(0, 0, 0.5)], "columns")
+    with pytest.raises(ModelError, match="one cost per column key"):
+        union(shape, [*parts, clash])
