@@ -106,7 +106,7 @@ class SimplexProtocol:
         # the basis only changes in merge_and_solve, which says so: its wire form is kept
         # between changes (most rounds of an epoch change nothing)
         if changed or self._columns is None:
-            self._columns = tuple((int(c.kind), c.robot, c.task, c.cost) for c in self.agent.basis)
+            self._columns = self.agent.basis_rows()
         message = SimplexBasis(now_ns, self.epoch, self.name, self.agent.rounds, self._columns)
         return message, changed
 

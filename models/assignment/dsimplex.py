@@ -20,8 +20,8 @@ tests and benchmarks.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
-from typing import NamedTuple
+from collections.abc import Iterable, Iterator, Sequence
+from typing import NamedTuple, overload
 
 import numpy as np
 
@@ -38,6 +38,7 @@ from models.assignment.simplex import (
     columns_of,
     ranked,
     ranked_rows,
+    rows_of,
     solve_ranked,
     union,
 )
@@ -48,45 +49,96 @@ _KINDS = {int(kind): kind for kind in ColumnKind}
 """Column kinds by wire value: a dict lookup is ~10x cheaper than calling the enum."""
 
 
-class SharedBasis(tuple[Column, ...]):
+Row = tuple[int, int, int, float]
+"""A column in its wire form: ``(kind value, robot index, task index, cost)``."""
+
+
+class SharedBasis(Sequence[Column]):
     """A basis as a neighbour sent it, merged by every agent that received it.
 
-    A tuple of its m columns that also keeps their ranks and costs (:meth:`ranked_in`),
-    built on first use: 49 agents merging one basis lay its columns out once instead of 49
-    times. Do not build one from columns that may change (tuples of tuples never do).
+    Its m columns, and their ranks and costs (:meth:`ranked_in`) built on first use: 49
+    agents merging one basis lay it out once instead of 49 times. A basis made
+    :meth:`from_rows` (its wire form) builds its :class:`Column` objects only if they are
+    read: merging never reads them. Do not build one from columns or rows that may change
+    (tuples of tuples never do).
     """
 
-    _ranked: tuple[LpShape, RankedColumns] | None = None
-    _rows: Sequence[tuple[int, int, int, float]] | None = None
+    __slots__ = ("_columns", "_ranked", "_rows")
+
+    def __init__(self, columns: Iterable[Column] = ()) -> None:
+        self._columns: tuple[Column, ...] | None = tuple(columns)
+        self._rows: Sequence[Row] = ()
+        self._ranked: tuple[LpShape, RankedColumns] | None = None
 
     @classmethod
-    def from_rows(cls, rows: Sequence[tuple[int, int, int, float]]) -> SharedBasis:
-        """The basis of ``(kind, robot, task, cost)`` rows: its wire form.
+    def from_rows(cls, rows: Sequence[Row]) -> SharedBasis:
+        """The basis of ``(kind, robot, task, cost)`` rows: its wire form, read lazily.
 
-        The rows are kept: :meth:`ranked_in` reads them as one array.
-
-        Raises:
-            ModelError: ``columns`` for a kind that is no :class:`ColumnKind` value.
+        Rows that are not columns are refused when the basis is first read or laid out.
         """
-        try:
-            basis = cls(Column(_KINDS[k], r, t, c) for k, r, t, c in rows)
-        except (KeyError, TypeError, ValueError):
-            raise ModelError("columns", rows, "rows (kind 0-2, robot, task, cost)") from None
+        basis = cls()
+        basis._columns = None
         basis._rows = rows
         return basis
+
+    @property
+    def columns(self) -> tuple[Column, ...]:
+        """The columns, in the order sent.
+
+        Raises:
+            ModelError: ``columns`` for a row that is not a column (its kind no
+                :class:`ColumnKind` value, or not four fields).
+        """
+        if self._columns is None:
+            try:
+                self._columns = tuple(Column(_KINDS[k], r, t, c) for k, r, t, c in self._rows)
+            except (KeyError, TypeError, ValueError):
+                raise ModelError(
+                    "columns", self._rows, "rows (kind 0-2, robot, task, cost)"
+                ) from None
+        return self._columns
+
+    def __len__(self) -> int:
+        return len(self._rows) if self._columns is None else len(self._columns)
+
+    @overload
+    def __getitem__(self, index: int) -> Column: ...
+
+    @overload
+    def __getitem__(self, index: slice) -> tuple[Column, ...]: ...
+
+    def __getitem__(self, index: int | slice) -> Column | tuple[Column, ...]:
+        return self.columns[index]
+
+    def __iter__(self) -> Iterator[Column]:
+        return iter(self.columns)
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, SharedBasis | tuple | list):
+            return self.columns == tuple(other)
+        return NotImplemented
+
+    __hash__ = None  # type: ignore[assignment]  # equal to tuples and lists, like a list
+
+    def __repr__(self) -> str:
+        return f"SharedBasis({list(self)!r})"
 
     def ranked_in(self, shape: LpShape) -> RankedColumns:
         """The columns' ranks and costs in an LP of ``shape`` (computed once per shape).
 
         Raises:
-            ModelError: ``columns`` for a column out of range or a cost that is not finite.
+            ModelError: ``columns`` for a row that is not a column, a column out of range
+                or a cost that is not finite.
         """
         known = self._ranked
         if known is None or known[0] != shape:
             fast = None
-            if self._rows is not None:
-                fast = ranked_rows(shape, np.array(self._rows, dtype=np.float64))
-            known = (shape, fast if fast is not None else ranked(shape, self, "columns"))
+            if self._columns is None:
+                try:
+                    fast = ranked_rows(shape, np.array(self._rows, dtype=np.float64))
+                except (TypeError, ValueError):
+                    fast = None  # not rows of four numbers: reading the columns says why
+            known = (shape, fast if fast is not None else ranked(shape, self.columns, "columns"))
             self._ranked = known
         return known[1]
 
@@ -156,6 +208,10 @@ class SimplexAgent:
         if self._basis is None:
             self._basis = columns_of(self.shape, self._ranked)
         return list(self._basis)
+
+    def basis_rows(self) -> tuple[Row, ...]:
+        """The current basis in its wire form, ``(kind, robot, task, cost)`` rows, key order."""
+        return tuple(rows_of(self.shape, self._ranked))
 
     @property
     def converged(self) -> bool:

@@ -264,13 +264,15 @@ def union(shape: LpShape, parts: Sequence[RankedColumns]) -> RankedColumns:
 
 def columns_of(shape: LpShape, columns: RankedColumns) -> list[Column]:
     """The :class:`Column` of each rank and cost, in their order."""
+    return [Column(_KINDS[k], i, j, c) for k, i, j, c in rows_of(shape, columns)]
+
+
+def rows_of(shape: LpShape, columns: RankedColumns) -> list[tuple[int, int, int, float]]:
+    """Each rank and cost as a row ``(kind value, robot, task, cost)`` (the wire form)."""
     kind, robot, task = _unrank(shape, columns.rank)
-    return [
-        Column(_KINDS[k], i, j, c)
-        for k, i, j, c in zip(
-            kind.tolist(), robot.tolist(), task.tolist(), columns.cost.tolist(), strict=True
-        )
-    ]
+    return list(
+        zip(kind.tolist(), robot.tolist(), task.tolist(), columns.cost.tolist(), strict=True)
+    )
 
 
 def _unrank(shape: LpShape, rank: IntArray) -> tuple[IntArray, IntArray, IntArray]:

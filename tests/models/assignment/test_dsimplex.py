@@ -262,10 +262,24 @@ def test_a_basis_from_rows_keeps_its_columns_and_lays_them_out_as_they_would_be(
 
 
 @pytest.mark.parametrize("rows", [((3, 0, 0, 1.0),), ((0, 0, 0),), (("x", 0, 0, 1.0),)])
-def test_a_basis_from_rows_that_are_not_columns_is_rejected(rows):
+def test_a_basis_from_rows_that_are_not_columns_is_rejected_when_read_or_laid_out(rows):
     with pytest.raises(ModelError) as raised:
-        SharedBasis.from_rows(rows)
+        list(SharedBasis.from_rows(rows))
     assert raised.value.key == "columns"
+    with pytest.raises(ModelError) as raised:
+        SharedBasis.from_rows(rows).ranked_in(LpShape(2, 2))
+    assert raised.value.key == "columns"
+
+
+def test_an_agent_merging_a_basis_from_rows_never_builds_its_columns():
+    problem = AssignmentProblem(("a", "b"), (1, 2), np.array([[1.0, 2.0], [2.0, 1.0]]))
+    sender, receiver = agent_for(problem, [1], 0), agent_for(problem, [0], 0)
+    sender.merge_and_solve([])
+    wire = SharedBasis.from_rows(sender.basis_rows())
+    receiver.merge_and_solve([wire])
+    assert wire._columns is None  # laid out from its rows only
+    assert wire == sender.basis
+    assert receiver.assignment() == {0: 0, 1: 1}  # robot 1's column came through the rows
 
 
 def test_a_basis_from_rows_out_of_range_is_named_when_it_is_laid_out():
