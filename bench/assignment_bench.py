@@ -61,7 +61,7 @@ def _run(problem: AssignmentProblem, adjacent: list[list[int]]) -> Result:
     rounds = last_change = pivots = 0
     while not all(a.converged for a in agents):
         rounds += 1
-        sent = [a.basis for a in agents]
+        sent = [a.shared_basis() for a in agents]
         for k, agent in enumerate(agents):
             if agent.converged:
                 continue

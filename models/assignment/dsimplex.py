@@ -189,6 +189,7 @@ class SimplexAgent:
         # [x_B | B^-1 | 0] of the identity basis, rows in key order
         self._table = np.hstack([np.ones((m, 1)), np.eye(m), np.zeros((m, 1))])
         self._candidates: RankedColumns | None = None
+        self._shared: SharedBasis | None = None
         # received bases (by identity, held so that ids stay theirs) whose columns are all
         # candidates: a neighbour resends the same basis object until it changes
         self._merged: dict[int, Sequence[Column]] = {}
@@ -208,6 +209,19 @@ class SimplexAgent:
         if self._basis is None:
             self._basis = columns_of(self.shape, self._ranked)
         return list(self._basis)
+
+    def shared_basis(self) -> SharedBasis:
+        """The current basis as a :class:`SharedBasis`, to send to the neighbours.
+
+        The same object until the basis changes, laid out already: a receiver reads its
+        ranks, and skips a round in which nothing it received is new.
+        """
+        shared = self._shared
+        if shared is None:
+            shared = SharedBasis.from_rows(self.basis_rows())
+            shared._ranked = (self.shape, self._ranked)
+            self._shared = shared
+        return shared
 
     def basis_rows(self) -> tuple[Row, ...]:
         """The current basis in its wire form, ``(kind, robot, task, cost)`` rows, key order."""
@@ -252,13 +266,13 @@ class SimplexAgent:
             self.unchanged += 1
             return False
         # ranks and costs: a received basis's arrays are built once for every agent that
-        # merges it (SharedBasis)
+        # merges it (SharedBasis); plain sequences overlap, and are laid out once together
         shape = self.shape
         parts = [self._known_ranked, self._ranked]
-        parts += [
-            b.ranked_in(shape) if isinstance(b, SharedBasis) else ranked(shape, b, "columns")
-            for b in received
-        ]
+        parts += [b.ranked_in(shape) for b in received if isinstance(b, SharedBasis)]
+        plain = [b for b in received if not isinstance(b, SharedBasis)]
+        if plain:
+            parts.append(ranked(shape, list(set().union(*plain)), "columns"))
         columns = union(shape, parts)
         self.solved = not _within(columns, self._candidates)
         if not self.solved:
@@ -277,6 +291,7 @@ class SimplexAgent:
         if changed:
             self._ranked = best
             self._basis = None
+            self._shared = None
         self._table = solution.table
         self.pivots = solution.pivots
         self.unchanged = 0 if changed else self.unchanged + 1
@@ -351,7 +366,9 @@ def run_synchronous(
     """Run the distributed simplex in lock step until every agent has halted.
 
     In round t every agent that has not halted receives its neighbours' bases of round
-    t - 1 (halted agents keep sending theirs) and solves.
+    t - 1 (halted agents keep sending theirs) and solves. Each agent sends its
+    :meth:`SimplexAgent.shared_basis`, one object until its basis changes, as a sender's
+    wire basis is decoded once on the network.
 
     Args:
         problem: the LP.
@@ -386,7 +403,7 @@ def run_synchronous(
         if rounds >= max_rounds:
             raise RuntimeError(f"distributed simplex did not halt in {max_rounds} rounds")
         rounds += 1
-        sent = [a.basis for a in agents]
+        sent = [a.shared_basis() for a in agents]
         for k, agent in enumerate(agents):
             if agent.converged:
                 continue

@@ -26,7 +26,7 @@ from models.assignment.problem import (
     pair,
     unserved,
 )
-from models.assignment.simplex import assignment_of, columns_of, primal, solve
+from models.assignment.simplex import assignment_of, columns_of, primal, ranked, solve
 from models.errors import ModelError
 
 GRAPHS = ("complete", "ring", "random")
@@ -287,3 +287,16 @@ def test_a_basis_from_rows_out_of_range_is_named_when_it_is_laid_out():
     with pytest.raises(ModelError, match="indices within") as raised:
         basis.ranked_in(LpShape(2, 2))
     assert raised.value.value == pair(5, 0, 1.0)
+
+
+def test_an_agent_sends_one_shared_basis_until_its_basis_changes():
+    problem = AssignmentProblem(("a", "b"), (1, 2), np.array([[1.0, 2.0], [2.0, 1.0]]))
+    agent = agent_for(problem, [0, 1], 0)
+    first = agent.shared_basis()
+    assert agent.shared_basis() is first and first == agent.basis
+    assert agent.merge_and_solve([]) is True
+    second = agent.shared_basis()
+    assert second is not first and second == agent.basis
+    laid_out = ranked(problem.shape, agent.basis, "columns")
+    assert np.array_equal(second.ranked_in(problem.shape).rank, laid_out.rank)
+    assert agent.merge_and_solve([second]) is False and agent.shared_basis() is second
