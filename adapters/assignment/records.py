@@ -48,6 +48,7 @@ class _Epoch:
     messages: dict[int, int] = field(default_factory=dict)
     nbytes: dict[int, int] = field(default_factory=dict)
     closed: bool = False
+    takers: frozenset[int] | None = None  # robots with a finite cost, once every row is in
 
 
 class DtaRecords:
@@ -82,6 +83,7 @@ class DtaRecords:
         record = self.epochs.setdefault(epoch, _Epoch(announced_ns))
         record.start_ns = min(record.start_ns, announced_ns)
         record.rows[robot] = np.array(problem.cost[robot])
+        record.takers = None
         if record.problem is None:
             record.problem = problem
 
@@ -130,8 +132,10 @@ class DtaRecords:
         """Every robot has seen the epoch, and every robot that could take a task decided."""
         if len(record.rows) != len(self.names):
             return False
-        takers = {i for i, row in record.rows.items() if np.isfinite(row).any()}
-        return bool(takers) and takers <= set(record.decided_ns)
+        if record.takers is None:
+            record.takers = frozenset(i for i, row in record.rows.items() if np.isfinite(row).any())
+        takers = record.takers
+        return bool(takers) and all(i in record.decided_ns for i in takers)
 
     def _close(self, record: _Epoch) -> None:
         takers = [t for i, t in record.decided_ns.items() if np.isfinite(record.rows[i]).any()]

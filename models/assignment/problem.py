@@ -53,6 +53,11 @@ class ColumnKind(IntEnum):
     """``("unserved", j)``: nobody serves task ``j`` (big-M)."""
 
 
+KINDS = {int(kind): kind for kind in ColumnKind}
+"""Column kinds by value (wire form, rank digit): a dict lookup is ~10x cheaper than calling
+the enum."""
+
+
 class Column(NamedTuple):
     """One LP column. Tuples compare by key first; the key identifies the column.
 
