@@ -203,8 +203,8 @@ def ranked(shape: LpShape, columns: Sequence[Column], key: str) -> RankedColumns
 def ranked_rows(shape: LpShape, rows: FloatArray) -> RankedColumns | None:
     """:func:`ranked` of columns given as rows ``(kind, robot, task, cost)`` of one array.
 
-    A basis in its wire form becomes one array in a single call, 4x faster than reading
-    its :class:`Column` objects one by one.
+    A basis in its wire form becomes one array in a single call, about 3x faster than
+    reading its :class:`Column` objects one by one (25 against 73 us for 100 columns).
 
     Returns:
         None unless every kind is a :class:`ColumnKind` value, every index a whole number
