@@ -222,9 +222,7 @@ def test_bases_resent_as_the_same_objects_give_the_rounds_fresh_copies_give(
 
 
 @pytest.mark.parametrize("seed", range(3))
-def test_bases_received_with_their_column_sets_give_the_rounds_plain_lists_give(
-    seed, make_lp, make_graph
-):
+def test_bases_received_laid_out_once_give_the_rounds_plain_lists_give(seed, make_lp, make_graph):
     problem, neighbours, bound = _network(seed, make_lp, make_graph)
     n = len(problem.robots)
     keyed = [agent_for(problem, [i], bound) for i in range(n)]
