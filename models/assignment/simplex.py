@@ -47,9 +47,10 @@ pass as optimal. The pivot loop is compiled (:mod:`models.assignment.pivoting`).
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
+import numpy.typing as npt
 
 from models.arrays import FloatArray, IntArray
 from models.assignment.pivoting import CAP_HIT, UNBOUNDED, pivot_loop
@@ -214,16 +215,10 @@ def ranked_rows(shape: LpShape, rows: FloatArray) -> RankedColumns | None:
     if rows.ndim != 2 or rows.shape[1] != 4 or not bool(np.all(np.isfinite(rows))):
         return None
     kind, robot, task, cost = rows.T
-    r, t = shape
-    unserved = kind == ColumnKind.UNSERVED
-    kind_ok = (kind == ColumnKind.PAIR) | (kind == ColumnKind.IDLE) | unserved
-    robot_ok = np.where(unserved, robot == -1, (robot >= 0) & (robot < r))
-    task_ok = np.where(kind == ColumnKind.IDLE, task == -1, (task >= 0) & (task < t))
+    kind_ok = (kind >= ColumnKind.PAIR) & (kind <= ColumnKind.UNSERVED) & (kind == np.rint(kind))
     whole = (robot == np.rint(robot)) & (task == np.rint(task))
-    if not bool(np.all(kind_ok & robot_ok & task_ok & whole)):
-        return None
-    rank = ((kind * (r + 1) + robot + 1) * (t + 1) + task + 1).astype(np.int64)
-    return RankedColumns(rank, np.ascontiguousarray(cost))
+    rank = _ranks_within(shape, kind, robot, task) if bool(np.all(kind_ok & whole)) else None
+    return None if rank is None else RankedColumns(rank, np.ascontiguousarray(cost))
 
 
 def union(shape: LpShape, parts: Sequence[RankedColumns]) -> RankedColumns:
@@ -294,9 +289,7 @@ def _start_table(
     m = shape.rows
     if start.rank.size != m or np.unique(start.rank).size != m:
         raise ModelError("start_basis", start.rank.size, f"{m} distinct columns")
-    kind, robot, task = _unrank(shape, start.rank)
-    first = np.where(kind == ColumnKind.UNSERVED, shape.n_robots + task, robot)
-    second = np.where(kind == ColumnKind.PAIR, shape.n_robots + task, m)
+    first, second = _rows_of(shape, *_unrank(shape, start.rank))
     inverse = _inverse(m, first, second, start_inverse)
     # One table [x_B | B^-1 | 0]: one product-form update per pivot, and candidate column
     # j's w = B^-1 a_j is table[:, 1 + first[j]] + table[:, 1 + second[j]] (second = m -> 0).
@@ -317,9 +310,7 @@ def _solve(
     basis = np.searchsorted(candidates.rank, start_rank)
     if n == 0 or bool(np.any(candidates.rank[np.minimum(basis, n - 1)] != start_rank)):
         raise ModelError("start_basis", "not among the candidates", "a basis of candidates")
-    kind, robot, task = _unrank(shape, candidates.rank)
-    first = np.where(kind == ColumnKind.UNSERVED, shape.n_robots + task, robot)
-    second = np.where(kind == ColumnKind.PAIR, shape.n_robots + task, m)
+    first, second = _rows_of(shape, *_unrank(shape, candidates.rank))
     cost = candidates.cost
     exact = bool(np.all(cost == np.rint(cost))) and float(np.abs(cost).sum()) < _EXACT_INTEGER_SUM
     cap = 20 * (m + n) + 100 if max_pivots is None else max_pivots
@@ -400,16 +391,37 @@ def _layout_arrays(
     task = np.array(tasks)
     if robot.dtype.kind != "i" or task.dtype.kind != "i":
         return None
+    shape = LpShape(r, t)
+    rank = _ranks_within(shape, kind, robot, task)
+    return None if rank is None else (rank, *_rows_of(shape, kind, robot, task))
+
+
+def _ranks_within(
+    shape: LpShape, kind: npt.NDArray[Any], robot: npt.NDArray[Any], task: npt.NDArray[Any]
+) -> IntArray | None:
+    """The ranks of columns given by kind, robot and task arrays (int64).
+
+    None unless every robot and task index is within range for its kind (-1 where the kind
+    has none). Kinds must be :class:`ColumnKind` values.
+    """
+    r, t = shape
     unserved = kind == ColumnKind.UNSERVED
     robot_ok = np.where(unserved, robot == -1, (robot >= 0) & (robot < r))
     task_ok = np.where(kind == ColumnKind.IDLE, task == -1, (task >= 0) & (task < t))
     if not bool(np.all(robot_ok & task_ok)):
         return None
-    return (
-        ((kind * (r + 1) + robot + 1) * (t + 1) + task + 1).astype(np.int64),
-        np.where(unserved, r + task, robot).astype(np.int64),
-        np.where(kind == ColumnKind.PAIR, r + task, r + t).astype(np.int64),
-    )
+    rank: IntArray = ((kind * (r + 1) + robot + 1) * (t + 1) + task + 1).astype(np.int64)
+    return rank
+
+
+def _rows_of(
+    shape: LpShape, kind: npt.NDArray[Any], robot: npt.NDArray[Any], task: npt.NDArray[Any]
+) -> tuple[IntArray, IntArray]:
+    """Each column's first and second row of ones (m for a one-entry column)."""
+    r, t = shape
+    first = np.where(kind == ColumnKind.UNSERVED, r + task, robot).astype(np.int64)
+    second = np.where(kind == ColumnKind.PAIR, r + task, r + t).astype(np.int64)
+    return first, second
 
 
 def _inverse(
