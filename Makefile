@@ -9,7 +9,7 @@ OUT    ?= runs/demo
 STUDIES := runs/studies
 STUDY = $(BIN)/cosim study studies/$(1).toml --out $(STUDIES)/$(1) --resume
 
-.PHONY: setup demo test lint bench clean help reproduce study-comm study-comm-reduced \
+.PHONY: setup demo test test-fast lint bench clean help reproduce study-comm study-comm-reduced \
 	study-burst study-scale study-paper study-nav study-mapping study-mapping-reduced map-aces \
 	lab-real lab-mixed study-humans study-humans-reduced study-traffic
 
@@ -28,8 +28,11 @@ setup: $(STAMP)  ## create .venv and install cosim with its dev tools
 demo: setup  ## run the default scenario and say where the results are
 	$(BIN)/cosim run $(SCENARIO) --out $(OUT) --force
 
-test: setup  ## the whole test suite
-	$(BIN)/python -m pytest -q
+test: setup  ## the whole test suite, on every core (CI runs this)
+	$(BIN)/python -m pytest -q -n auto
+
+test-fast: setup  ## all but the slow tests (whole runs, SUMO, DDS, Dask, real time), on every core
+	$(BIN)/python -m pytest -q -n auto -m "not slow"
 
 lint: setup  ## ruff and mypy --strict
 	$(BIN)/ruff check cosim models adapters studies tests bench

@@ -9,8 +9,8 @@ from pathlib import Path
 from typing import Any
 
 import cosim
-from cosim.humans.session import SumoSession
-from cosim.runner import run
+from adapters.humans.session import SumoSession
+from cosim.runner.execute import run
 
 Result = dict[str, Any]
 DURATION_S = 60.0

@@ -16,8 +16,8 @@ from typing import Any
 import numpy as np
 
 import cosim
-from cosim.runner import execute
-from cosim.worldfiles import scenario_warehouse
+from adapters.world.warehouse import scenario_warehouse
+from cosim.runner.execute import execute
 from models.lidar import ScanGeometry
 from models.mapping.grid import LogOddsMap, MapGeometry
 from models.mapping.matcher import MatcherParams, match, scan_points
@@ -107,7 +107,7 @@ def fleet50_mapping(repeat: int) -> Result:
 
 def aces_mapping(repeat: int) -> Result:
     """`cosim map` on the ACES recording: speed and trajectory error, with and without loops."""
-    from cosim.bagmap import map_bag
+    from cosim.cli.bagmap import map_bag
 
     bag = SHARED / "aces_lidar"
     if not bag.is_dir():

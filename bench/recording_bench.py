@@ -21,9 +21,9 @@ from typing import Any
 import numpy as np
 
 import cosim
-from cosim.messages import LaserScan, Message, Odometry, TFMessage, Transform
+from cosim.core.messages import LaserScan, Message, Odometry, TFMessage, Transform
 from cosim.recording.schemas import typestore
-from cosim.runner import execute
+from cosim.runner.execute import execute
 
 Result = dict[str, Any]
 COST_TARGET = 0.20

@@ -24,11 +24,11 @@ from pathlib import Path
 from typing import Any, ClassVar, NamedTuple
 
 import cosim
-from cosim.adapter import RunContext
-from cosim.assembly import adapter_names
-from cosim.kernel import Stage
-from cosim.registry import AdapterRegistry
-from cosim.runner import execute
+from cosim.core.adapter import RunContext
+from cosim.core.kernel import Stage
+from cosim.core.registry import AdapterRegistry
+from cosim.runner.assembly import adapter_names
+from cosim.runner.execute import execute
 
 Result = dict[str, Any]
 RTF_TARGET = 1.0

@@ -21,13 +21,13 @@ from scale_bench import fleet_scaling
 from study_bench import study_throughput_200
 
 import cosim
-from cosim.adapter import RunContext
-from cosim.bus import Envelope
-from cosim.hosts import BASE_HOST, HostId
-from cosim.kernel import Kernel, Stage
-from cosim.messages import Message, Twist
-from cosim.registry import AdapterRegistry
-from cosim.runner import execute
+from cosim.core.adapter import RunContext
+from cosim.core.bus import Envelope
+from cosim.core.hosts import BASE_HOST, HostId
+from cosim.core.kernel import Kernel, Stage
+from cosim.core.messages import Message, Twist
+from cosim.core.registry import AdapterRegistry
+from cosim.runner.execute import execute
 from models.kinematics import FleetState
 
 Result = dict[str, Any]
@@ -240,8 +240,8 @@ BREAKDOWN = {
     "  local control (DWA kernel)": ("models/navigation/dwa.py", "dwa_batch"),
     "physics tick (kinematics, collisions, odometry)": ("adapters/fleet/motion.py", "_tick"),
     "  collision checks": ("adapters/fleet/collisions.py", "guard"),
-    "bus publish (one message)": ("cosim/bus.py", "publish"),
-    "bus publish_many (a fleet's scans, odometry, commands)": ("cosim/bus.py", "publish_many"),
+    "bus publish (one message)": ("cosim/core/bus.py", "publish"),
+    "bus publish_many (a fleet's scans, odometry, commands)": ("cosim/core/bus.py", "publish_many"),
 }
 
 

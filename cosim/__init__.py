@@ -13,7 +13,7 @@ from typing import Any
 
 import pandas as pd
 
-from cosim.errors import (
+from cosim.core.errors import (
     BridgeError,
     ConfigError,
     CosimError,
@@ -21,7 +21,7 @@ from cosim.errors import (
     RegistryError,
     ScenarioError,
 )
-from cosim.runner import RunResult, run
+from cosim.runner.execute import RunResult, run
 from cosim.scenario import Scenario, load_scenario
 
 

@@ -1,5 +1,5 @@
 """``python -m cosim`` runs the command line."""
 
-from cosim.cli import main
+from cosim.cli.main import main
 
 raise SystemExit(main())

@@ -1,6 +1,6 @@
 """Dynamic task assignment on the robots: the fleet-management layer of the paper.
 
-Every robot hears the task source's :class:`~cosim.messages.TaskSet` (an *epoch*: the open
+Every robot hears the task source's :class:`~cosim.core.messages.TaskSet` (an *epoch*: the open
 tasks), computes its own costs from its own pose, and runs ``assignment.protocol`` with
 its neighbours over the network, one round every ``assignment.period_ms`` (a robot whose
 protocol has halted skips the round until it hears from a neighbour or its state is due
@@ -19,19 +19,18 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 import numpy as np
 
+from adapters.assignment.commitments import Commitments, RobotTasks
 from adapters.assignment.protocols import (
-    AssignmentProtocol,
     BasisDecoder,
     CbbaProtocol,
     GreedyProtocol,
     SimplexProtocol,
 )
-from adapters.assignment.records import DtaRecords
+from adapters.assignment.tables import DtaRecords
 from adapters.assignment.topics import (
     ASSIGNMENT,
     BASES,
@@ -47,11 +46,11 @@ from adapters.assignment.topics import (
 )
 from adapters.naming import topic
 from adapters.network.link import NetworkView
-from cosim.adapter import RunContext
-from cosim.bus import Envelope
-from cosim.hosts import HostId
-from cosim.kernel import Stage
-from cosim.messages import (
+from cosim.core.adapter import RunContext
+from cosim.core.bus import Envelope
+from cosim.core.hosts import HostId
+from cosim.core.kernel import Stage
+from cosim.core.messages import (
     AuctionBids,
     Message,
     NavGoal,
@@ -68,41 +67,14 @@ from cosim.messages import (
     TaskOrder,
     TaskSet,
 )
-from cosim.timebase import period_ns, s_to_ns
+from cosim.core.timebase import period_ns, s_to_ns
+from cosim.scenario.sections import AssignmentConfig, TasksConfig
 from models.assignment.problem import AssignmentProblem
 from models.kinematics import FleetState
 from models.navigation.costmap import StaticCostmap
 from models.navigation.planner import shortest_path_length_m
 from models.network.topology import diameter
 from models.world import Warehouse
-
-RETRY_S = 1.0
-"""Period of service requests and done reports until answered (s)."""
-BLOCKED_S = 60.0
-"""A task a robot got stuck on is not its to take for this long (s)."""
-
-
-@dataclass
-class RobotTasks:
-    """One robot's view of the tasks and what it is doing about them."""
-
-    index: int
-    name: str
-    phase: str = "idle"  # idle | heading | requesting | serving | reporting
-    task: int = -1
-    task_cost: float = 0.0
-    goal_id: int = 0
-    until_ns: int = 0
-    last_sent_ns: int = -(1 << 62)
-    epoch: int = 0
-    tasks: tuple[TaskInfo, ...] = ()
-    costs: tuple[float, ...] = ()
-    protocol: AssignmentProtocol | None = None
-    acted: bool = False
-    inbox: list[Message] = field(default_factory=list)
-    claims: dict[int, tuple[str, float]] = field(default_factory=dict)
-    blocked: dict[int, int] = field(default_factory=dict)
-    last_broadcast_ns: int = -(1 << 62)
 
 
 class DtaAdapter:
@@ -112,13 +84,11 @@ class DtaAdapter:
     requires: ClassVar[tuple[str, ...]] = ("fleet", "network", "navigation", "task_source")
 
     def __init__(self, run: RunContext) -> None:
-        self.cfg = run.scenario.assignment
-        self.dwell_ns = s_to_ns(run.scenario.tasks.dwell_s)
+        self.cfg = run.settings(AssignmentConfig)
         fleet = run.service(FleetState)
         self.fleet = fleet
         self.robots = [RobotTasks(i, n) for i, n in enumerate(fleet.names)]
         self.names = list(fleet.names)
-        self.rank = {n: i for i, n in enumerate(self.names)}
         self.hosts = [HostId(n) for n in self.names]
         self.pose = np.stack([fleet.x, fleet.y], axis=1)
         self.static = run.service(StaticCostmap)
@@ -134,6 +104,16 @@ class DtaAdapter:
         self.reward_m = 10.0 * float(math.hypot(width, height))
         self.records = DtaRecords(
             run.recorder, self.names, compare=self.cfg.protocol in ("distributed_simplex", "cbba")
+        )
+        self.duties = Commitments(
+            self.names,
+            self.hosts,
+            self.pose,
+            self.records,
+            self._cost,
+            dwell_ns=s_to_ns(run.settings(TasksConfig).dwell_s),
+            rebroadcast_ns=self.rebroadcast_ns,
+            preemption=self.cfg.preemption,
         )
         self._advertise(run)
 
@@ -196,16 +176,16 @@ class DtaAdapter:
                 if message.epoch == robot.epoch and message.robot != robot.name:
                     robot.inbox.append(message)
             elif isinstance(message, TaskClaim):
-                self._on_claim(run, robot, message)
+                self.duties.on_claim(run, robot, message)
             elif isinstance(message, NavStatus):
-                self._on_nav(run, robot, message)
+                self.duties.on_nav(run, robot, message)
             elif isinstance(message, ServiceReply):
-                self._on_reply(run, robot, message)
+                self.duties.on_reply(run, robot, message)
             elif isinstance(message, TaskDone):
                 if robot.phase == "reporting" and message.task_id == robot.task:
-                    self._become_idle(robot)  # the source acknowledged
+                    self.duties.become_idle(robot)  # the source acknowledged
             elif isinstance(message, TaskOrder):
-                self._on_order(run, robot, message)
+                self.duties.on_order(run, robot, message)
 
         return on
 
@@ -273,7 +253,7 @@ class DtaAdapter:
 
     def _round_of(self, run: RunContext, robot: RobotTasks, now_ns: int) -> None:
         """One protocol round of ``robot``: keep its promises, step, broadcast, act."""
-        self._keep_promises(run, robot, now_ns)
+        self.duties.keep_promises(run, robot, now_ns)
         protocol = robot.protocol
         if protocol is None:
             return
@@ -307,7 +287,7 @@ class DtaAdapter:
             robot.acted = True
             self.records.decided(robot.index, robot.epoch, now_ns, protocol)
             self._announce(run, robot, now_ns, protocol.task(), protocol.rounds)
-            self._act(run, robot, protocol.task())
+            self.duties.act(run, robot, protocol.task())
 
     def _announce(
         self, run: RunContext, robot: RobotTasks, now_ns: int, index: int | None, rounds: int
@@ -318,123 +298,6 @@ class DtaAdapter:
             task_id, cost = robot.tasks[index].task_id, robot.costs[index]
         decision = TaskAssignment(now_ns, robot.epoch, robot.name, task_id, cost, rounds)
         run.bus.publish(ASSIGNMENT, decision, self.hosts[robot.index])
-
-    # -- acting on a decision ------------------------------------------------------------------
-    def _act(self, run: RunContext, robot: RobotTasks, index: int | None) -> None:
-        task = robot.tasks[index] if index is not None and index < len(robot.tasks) else None
-        if robot.phase in ("requesting", "serving", "reporting"):
-            return  # at the task already: finish it
-        if robot.phase == "heading":
-            if task is not None and task.task_id == robot.task:
-                return
-            if not self.cfg.preemption:
-                return
-            self._release(run, robot, "re-assigned")
-        if task is None:
-            if robot.phase == "heading":
-                self._cancel(run, robot)
-            return
-        x, y = self.pose[robot.index]
-        self._take(run, robot, task, self._cost(x, y, task))
-
-    def _take(self, run: RunContext, robot: RobotTasks, task: TaskInfo, cost: float) -> None:
-        now = run.kernel.now_ns
-        robot.phase = "heading"
-        robot.task = task.task_id
-        robot.task_cost = cost
-        robot.goal_id += 1
-        self._claim(run, robot, now)
-        goal = NavGoal(now, robot.goal_id, task.x_m, task.y_m)
-        run.bus.publish(topic(robot.name, "nav/goal"), goal, self.hosts[robot.index])
-
-    def _claim(self, run: RunContext, robot: RobotTasks, now_ns: int) -> None:
-        claim = TaskClaim(now_ns, robot.epoch, robot.task, robot.name, robot.task_cost, "claim")
-        robot.last_sent_ns = now_ns
-        robot.claims[robot.task] = (robot.name, robot.task_cost)
-        run.bus.publish(CLAIMS, claim, self.hosts[robot.index])
-
-    def _release(self, run: RunContext, robot: RobotTasks, why: str) -> None:
-        now = run.kernel.now_ns
-        release = TaskClaim(now, robot.epoch, robot.task, robot.name, robot.task_cost, "release")
-        run.bus.publish(CLAIMS, release, self.hosts[robot.index])
-        robot.claims.pop(robot.task, None)
-        self.records.released(now, robot.index, robot.task, why)
-        self._become_idle(robot)
-
-    def _cancel(self, run: RunContext, robot: RobotTasks) -> None:
-        robot.goal_id += 1
-        cancel = NavGoal(run.kernel.now_ns, robot.goal_id, math.nan, math.nan)
-        run.bus.publish(topic(robot.name, "nav/goal"), cancel, self.hosts[robot.index])
-
-    def _become_idle(self, robot: RobotTasks) -> None:
-        robot.phase = "idle"
-        robot.task = -1
-
-    def _keep_promises(self, run: RunContext, robot: RobotTasks, now_ns: int) -> None:
-        """Repeat claims while holding a task; retry requests and reports; end dwells."""
-        host = self.hosts[robot.index]
-        due = now_ns - robot.last_sent_ns >= s_to_ns(RETRY_S)
-        if robot.phase == "heading" and now_ns - robot.last_sent_ns >= self.rebroadcast_ns:
-            self._claim(run, robot, now_ns)
-        elif robot.phase == "requesting" and due:
-            robot.last_sent_ns = now_ns
-            run.bus.publish(SERVICE_REQUESTS, ServiceRequest(now_ns, robot.task, robot.name), host)
-        elif robot.phase == "serving" and now_ns >= robot.until_ns:
-            robot.phase = "reporting"
-            robot.last_sent_ns = -(1 << 62)
-        if robot.phase == "reporting" and now_ns - robot.last_sent_ns >= s_to_ns(RETRY_S):
-            robot.last_sent_ns = now_ns
-            run.bus.publish(DONE, TaskDone(now_ns, robot.task, robot.name), host)
-
-    # -- messages -------------------------------------------------------------------------------
-    def _on_claim(self, run: RunContext, robot: RobotTasks, claim: TaskClaim) -> None:
-        if claim.robot == robot.name:
-            return
-        if claim.state == "release":
-            if robot.claims.get(claim.task_id, ("", 0.0))[0] == claim.robot:
-                robot.claims.pop(claim.task_id, None)
-            return
-        robot.claims[claim.task_id] = (claim.robot, claim.cost_m)
-        if robot.phase == "heading" and claim.task_id == robot.task:
-            theirs = (claim.cost_m, self.rank[claim.robot])
-            mine = (robot.task_cost, robot.index)
-            if theirs < mine:  # they win: give way, the fleet re-assigns
-                self.records.conflict(run.kernel.now_ns, robot.index, robot.task, claim.robot)
-                self._cancel(run, robot)
-                self._become_idle(robot)
-                robot.claims[claim.task_id] = (claim.robot, claim.cost_m)
-
-    def _on_nav(self, run: RunContext, robot: RobotTasks, status: NavStatus) -> None:
-        if robot.phase != "heading" or status.goal_id != robot.goal_id:
-            return
-        now = run.kernel.now_ns
-        if status.state == "arrived":
-            robot.phase = "requesting"
-            robot.last_sent_ns = -(1 << 62)
-            self._keep_promises(run, robot, now)
-        elif status.state in ("stuck", "unreachable"):
-            robot.blocked[robot.task] = now + s_to_ns(BLOCKED_S)
-            self._release(run, robot, status.state)
-
-    def _on_reply(self, run: RunContext, robot: RobotTasks, reply: ServiceReply) -> None:
-        if robot.phase != "requesting" or reply.task_id != robot.task:
-            return
-        if reply.granted:
-            robot.phase = "serving"
-            robot.until_ns = run.kernel.now_ns + self.dwell_ns
-        else:
-            self.records.released(run.kernel.now_ns, robot.index, robot.task, "refused")
-            robot.claims.pop(robot.task, None)
-            self._become_idle(robot)
-
-    def _on_order(self, run: RunContext, robot: RobotTasks, order: TaskOrder) -> None:
-        match = [t for t in robot.tasks if t.task_id == order.task_id]
-        if order.robot == robot.name and robot.phase == "idle" and match:
-            self._take(run, robot, match[0], order.cost_m)
-            decision = TaskAssignment(
-                run.kernel.now_ns, order.epoch, robot.name, order.task_id, order.cost_m, 0
-            )
-            run.bus.publish(ASSIGNMENT, decision, self.hosts[robot.index])
 
     def _report(self, run: RunContext, now_ns: int) -> None:
         """Centralized baseline: every robot reports its pose to the base station."""

@@ -13,7 +13,7 @@ from typing import Protocol
 
 import numpy as np
 
-from cosim.messages import AuctionBids, Message, SimplexBasis
+from cosim.core.messages import AuctionBids, Message, SimplexBasis
 from models.assignment.cbaa import CbaaAgent, scores_from_cost
 from models.assignment.dsimplex import SharedBasis, agent_for
 from models.assignment.greedy import nearest_free

@@ -13,12 +13,13 @@ from typing import Any, ClassVar
 import numpy as np
 
 from adapters.naming import topic
-from cosim.adapter import RunContext
-from cosim.bus import Envelope
-from cosim.hosts import HostId
-from cosim.kernel import Stage
-from cosim.messages import LaserScan, Message, Twist
-from cosim.timebase import period_ns
+from cosim.core.adapter import RunContext
+from cosim.core.bus import Envelope
+from cosim.core.hosts import HostId
+from cosim.core.kernel import Stage
+from cosim.core.messages import LaserScan, Message, Twist
+from cosim.core.timebase import period_ns
+from cosim.scenario.sections import LidarConfig, RobotsConfig
 from models.kinematics import FleetState
 from models.wander import WanderParams, wander
 
@@ -32,8 +33,8 @@ class WanderAdapter:
     def __init__(self, run: RunContext) -> None:
         self.names = list(run.service(FleetState).names)
         self.hosts = [HostId(name) for name in self.names]
-        robots = run.scenario.robots
-        lidar = run.scenario.lidar
+        robots = run.settings(RobotsConfig)
+        lidar = run.settings(LidarConfig)
         self.max_speed_mps = robots.max_speed_mps
         self.max_yaw_rate_radps = robots.max_yaw_rate_radps
         self.range_max_m = lidar.range_max_m

@@ -19,12 +19,13 @@ from shapely.geometry import LineString, box
 from shapely.prepared import prep
 
 from adapters.naming import topic
-from cosim.adapter import RunContext
-from cosim.bus import Envelope
-from cosim.hosts import HostId
-from cosim.kernel import Stage
-from cosim.messages import Goal, Message, Odometry, Twist
-from cosim.timebase import period_ns, s_to_ns
+from cosim.core.adapter import RunContext
+from cosim.core.bus import Envelope
+from cosim.core.hosts import HostId
+from cosim.core.kernel import Stage
+from cosim.core.messages import Goal, Message, Odometry, Twist
+from cosim.core.timebase import period_ns, s_to_ns
+from cosim.scenario.sections import RobotsConfig
 from models.goto import GoToGains, go_to_goal
 from models.kinematics import FleetState
 from models.world import Warehouse
@@ -49,10 +50,10 @@ class WaypointsAdapter:
         fleet = run.service(FleetState)
         self.names = list(fleet.names)
         count = len(self.names)
-        self.radius_m = run.scenario.robots.radius_m
-        self.max_speed_mps = run.scenario.robots.max_speed_mps
+        self.radius_m = run.settings(RobotsConfig).radius_m
+        self.max_speed_mps = run.settings(RobotsConfig).max_speed_mps
         self.gains = GoToGains()
-        self.period_ns = period_ns(run.scenario.robots.control_hz)
+        self.period_ns = period_ns(run.settings(RobotsConfig).control_hz)
         self.rngs = [run.rng.stream(f"waypoints/{name}") for name in self.names]
         self.hosts = [HostId(name) for name in self.names]
         self.pose = fleet.positions.copy()

@@ -19,8 +19,8 @@ from typing import Any, ClassVar
 import numpy as np
 
 from adapters.fleet.motion import FleetAdapter
-from cosim.adapter import RunContext
-from cosim.timebase import NS_PER_S
+from cosim.core.adapter import RunContext
+from cosim.core.timebase import NS_PER_S
 from models.collision import CollisionChecker, OtherKind, Proximity
 from models.kinematics import FleetState, Motion
 from models.obstacles import DynamicObstacles

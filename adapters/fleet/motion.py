@@ -18,13 +18,14 @@ import numpy as np
 
 from adapters.fleet.mirror import Mirrors
 from adapters.naming import robot_name, topic
-from cosim.adapter import RunContext
-from cosim.bus import Envelope
-from cosim.hosts import HostKind
-from cosim.kernel import Stage
-from cosim.messages import Message, Odometry, Twist
-from cosim.rng import BlockDraws
-from cosim.timebase import NS_PER_S, period_ns
+from cosim.core.adapter import RunContext
+from cosim.core.bus import Envelope
+from cosim.core.hosts import HostKind
+from cosim.core.kernel import Stage
+from cosim.core.messages import Message, Odometry, Twist
+from cosim.core.rng import BlockDraws
+from cosim.core.timebase import NS_PER_S, period_ns
+from cosim.scenario.sections import OdometryConfig, RobotsConfig
 from models.kinematics import DriveLimits, FleetState, Motion
 from models.odometry import advance, drift_increments
 from models.world import Warehouse
@@ -35,7 +36,7 @@ MotionGuard = Callable[[int, Motion], None]
 
 def drive_limits(run: RunContext) -> DriveLimits:
     """The scenario's drive limits."""
-    robots = run.scenario.robots
+    robots = run.settings(RobotsConfig)
     return DriveLimits(
         max_speed_mps=robots.max_speed_mps,
         max_reverse_mps=robots.max_reverse_mps,
@@ -53,7 +54,7 @@ class FleetAdapter:
 
     def __init__(self, run: RunContext) -> None:
         world = run.service(Warehouse)
-        robots = run.scenario.robots
+        robots = run.settings(RobotsConfig)
         names = [robot_name(i) for i in range(robots.count)]
         self.state = FleetState(names, world.starts, robots.radius_m)
         self.limits = drive_limits(run)
@@ -61,7 +62,7 @@ class FleetAdapter:
         self.period_ns = period_ns(robots.control_hz)
         self.dt_s = self.period_ns / NS_PER_S
         self.guards: list[MotionGuard] = []
-        self.drift = run.scenario.odometry.drift
+        self.drift = run.settings(OdometryConfig).drift
         self.odom = world.starts.astype(float).copy()
         self._noise = BlockDraws([run.rng.stream(f"odometry/{n}") for n in names], width=2)
         self._frames = [(f"{n}/odom", f"{n}/base_link") for n in names]

@@ -26,14 +26,14 @@ from typing import Any, ClassVar
 import numpy as np
 
 from adapters.mapping.geometry import map_geometry
-from adapters.mapping.records import MappingRecords
+from adapters.mapping.tables import MappingRecords
 from adapters.naming import topic
 from adapters.navigation.robots_layer import ROBOT_STATES
-from cosim.adapter import RunContext
-from cosim.bus import Envelope, TopicQos
-from cosim.hosts import BASE_HOST, HostId
-from cosim.kernel import Stage
-from cosim.messages import (
+from cosim.core.adapter import RunContext
+from cosim.core.bus import Envelope, TopicQos
+from cosim.core.hosts import BASE_HOST, HostId
+from cosim.core.kernel import Stage
+from cosim.core.messages import (
     LaserScan,
     LocalizedScan,
     MapUpdate,
@@ -44,8 +44,9 @@ from cosim.messages import (
     TFMessage,
     Transform,
 )
+from cosim.core.timebase import period_ns, s_to_ns
 from cosim.scenario.mapping import MappingConfig
-from cosim.timebase import period_ns, s_to_ns
+from cosim.scenario.sections import LidarConfig, NavigationConfig, RobotsConfig
 from models.arrays import FloatArray
 from models.errors import ModelError
 from models.kinematics import FleetState
@@ -101,12 +102,12 @@ class MappingAdapter:
     requires: ClassVar[tuple[str, ...]] = ("world", "fleet", "lidar", "network")
 
     def __init__(self, run: RunContext) -> None:
-        self.cfg = run.scenario.mapping
+        self.cfg = run.settings(MappingConfig)
         world = run.service(Warehouse)
         self.fleet = run.service(FleetState)
         self.names = list(self.fleet.names)
         self.hosts = [HostId(n) for n in self.names]
-        lidar = run.scenario.lidar
+        lidar = run.settings(LidarConfig)
         self.angles = ScanGeometry(
             lidar.beams, math.radians(lidar.fov_deg), lidar.range_min_m, lidar.range_max_m
         ).angles()
@@ -136,10 +137,10 @@ class MappingAdapter:
         elif self.cfg.share == "maps":
             bus.advertise(UPDATES, MapUpdate)
         self.recorder = run.recorder
-        nav = run.scenario.navigation
+        nav = run.settings(NavigationConfig)
         # with a robots layer each robot hears where the others are: returns off them are
         # left out of its map and its matching (robots are not the building)
-        self.robots_layer = nav.robots_layer and run.scenario.robots.driver in (
+        self.robots_layer = nav.robots_layer and run.settings(RobotsConfig).driver in (
             "navigation",
             "tasks",
         )

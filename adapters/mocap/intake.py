@@ -15,12 +15,14 @@ from __future__ import annotations
 import math
 
 from adapters.fleet.mirror import Mirrors
-from adapters.mocap.records import MocapRecords
+from adapters.mocap.tables import MocapRecords
 from adapters.naming import topic
-from cosim.adapter import RunContext
-from cosim.hosts import HostId
-from cosim.messages import PoseStamped
-from cosim.timebase import NS_PER_S
+from cosim.core.adapter import RunContext
+from cosim.core.hosts import HostId
+from cosim.core.messages import PoseStamped
+from cosim.core.timebase import NS_PER_S
+from cosim.scenario.mixed import MocapConfig
+from cosim.scenario.sections import RobotsConfig
 from models.kinematics import FleetState
 from models.mocap.gate import PoseGate
 
@@ -43,7 +45,7 @@ class PoseIntake:
 
     def __init__(self, run: RunContext, host: HostId) -> None:
         fleet = run.service(FleetState)
-        robots = run.scenario.robots
+        robots = run.settings(RobotsConfig)
         self.run = run
         self.host = host
         self.names = list(fleet.names)
@@ -51,7 +53,7 @@ class PoseIntake:
         self.gate = PoseGate(
             max_speed_mps=max(robots.max_speed_mps, robots.max_reverse_mps),
             max_yaw_rate_radps=robots.max_yaw_rate_radps,
-            tolerance_m=run.scenario.mocap.jump_tolerance_m,
+            tolerance_m=run.settings(MocapConfig).jump_tolerance_m,
             tolerance_rad=JUMP_TOLERANCE_RAD,
         )
         n = len(self.names)

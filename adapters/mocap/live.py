@@ -10,12 +10,12 @@ from __future__ import annotations
 
 from typing import Any, Protocol
 
-from adapters.physical.session import dds_session
-from cosim.adapter import RunContext
-from cosim.mocap.live import MotionCaptureFeed, mock_bodies
-from cosim.ros2dds.qos import QosKind
-from cosim.ros2dds.types import PoseStamped as DdsPoseStamped
-from cosim.ros2dds.types import planar_pose
+from adapters.mocap.feed import MotionCaptureFeed, mock_bodies
+from adapters.ros2dds.qos import QosKind
+from adapters.ros2dds.session import dds_session
+from adapters.ros2dds.types import PoseStamped as DdsPoseStamped
+from adapters.ros2dds.types import planar_pose
+from cosim.core.adapter import RunContext
 from cosim.scenario.mixed import MocapConfig
 from models.kinematics import FleetState
 

@@ -26,15 +26,16 @@ import simpy
 
 from adapters.mocap.intake import PoseIntake
 from adapters.mocap.live import LiveSource, open_live_source
-from adapters.mocap.records import MocapRecords
+from adapters.mocap.tables import MocapRecords
 from adapters.mocap.tracking import external_bodies, simulated_robots
-from cosim.adapter import RunContext
-from cosim.errors import ConfigError
-from cosim.hosts import HostKind
-from cosim.kernel import Stage
-from cosim.mocap.tracks import PoseTrack, read_pose_track
-from cosim.rng import BlockDraws
-from cosim.timebase import ms_to_ns, period_ns
+from adapters.mocap.tracks import PoseTrack, read_pose_track
+from cosim.core.adapter import RunContext
+from cosim.core.errors import ConfigError
+from cosim.core.hosts import HostKind
+from cosim.core.kernel import Stage
+from cosim.core.rng import BlockDraws
+from cosim.core.timebase import ms_to_ns, period_ns
+from cosim.scenario.mixed import MocapConfig
 from models.kinematics import FleetState
 from models.mocap.sampling import MocapParams, measure
 
@@ -48,7 +49,7 @@ class MocapAdapter:
     requires: ClassVar[tuple[str, ...]] = ("fleet",)
 
     def __init__(self, run: RunContext) -> None:
-        self.cfg = cfg = run.scenario.mocap
+        self.cfg = cfg = run.settings(MocapConfig)
         self.source = run.scenario.source
         if cfg.source == "none":
             raise ConfigError(

@@ -6,11 +6,12 @@ bridge, the robots' localization), so they cannot disagree.
 
 from __future__ import annotations
 
-from cosim.errors import ConfigError
-from cosim.scenario.model import Scenario
+from cosim.core.adapter import ScenarioView
+from cosim.core.errors import ConfigError
+from cosim.scenario.mixed import MocapConfig, PhysicalConfig
 
 
-def _check_names(scenario: Scenario, names: list[str], robots: list[str], key: str) -> None:
+def _check_names(scenario: ScenarioView, names: list[str], robots: list[str], key: str) -> None:
     for robot in robots:
         if robot not in names:
             raise ConfigError(
@@ -19,7 +20,7 @@ def _check_names(scenario: Scenario, names: list[str], robots: list[str], key: s
             )
 
 
-def external_bodies(scenario: Scenario, names: list[str]) -> list[tuple[str, str]]:
+def external_bodies(scenario: ScenarioView, names: list[str]) -> list[tuple[str, str]]:
     """(robot, body) of an external mocap source (``bag``, ``motioncapture``, ``ros2``).
 
     Defaults: the first robot with the bag's only pose topic; each physical robot by its
@@ -28,11 +29,11 @@ def external_bodies(scenario: Scenario, names: list[str]) -> list[tuple[str, str
     Raises:
         ConfigError: for unknown robots, or a live source that tracks nobody.
     """
-    cfg = scenario.mocap
+    cfg = scenario.section(MocapConfig)
     if not cfg.external:
         return []
     pairs = list(cfg.bodies)
-    physical = list(scenario.physical.robots)
+    physical = list(scenario.section(PhysicalConfig).robots)
     if not pairs:
         if cfg.source == "bag":
             pairs = [(names[0], "")]
@@ -49,17 +50,17 @@ def external_bodies(scenario: Scenario, names: list[str]) -> list[tuple[str, str
     return pairs
 
 
-def physical_robots(scenario: Scenario, names: list[str]) -> list[str]:
+def physical_robots(scenario: ScenarioView, names: list[str]) -> list[str]:
     """The physical robots, checked against the fleet and the pose they need.
 
     Raises:
         ConfigError: for an unknown robot, or a physical robot that would have no pose.
     """
-    robots = list(scenario.physical.robots)
+    robots = list(scenario.section(PhysicalConfig).robots)
     _check_names(scenario, names, robots, "physical.robots")
-    if scenario.physical.pose == "mocap" and robots:
+    if scenario.section(PhysicalConfig).pose == "mocap" and robots:
         tracked = {robot for robot, _ in external_bodies(scenario, names)}
-        live = scenario.mocap.source in ("motioncapture", "ros2")
+        live = scenario.section(MocapConfig).source in ("motioncapture", "ros2")
         missing = [robot for robot in robots if robot not in tracked or not live]
         if missing:
             raise ConfigError(
@@ -70,24 +71,24 @@ def physical_robots(scenario: Scenario, names: list[str]) -> list[str]:
     return robots
 
 
-def simulated_robots(scenario: Scenario, names: list[str]) -> list[str]:
+def simulated_robots(scenario: ScenarioView, names: list[str]) -> list[str]:
     """The robots a simulated mocap tracks (``mocap.robots``, or all).
 
     Raises:
         ConfigError: for a robot that is not in the fleet.
     """
-    tracked = list(scenario.mocap.robots) or list(names)
+    tracked = list(scenario.section(MocapConfig).robots) or list(names)
     _check_names(scenario, names, tracked, "mocap.robots")
     return tracked
 
 
-def tracked_robots(scenario: Scenario, names: list[str]) -> list[str]:
+def tracked_robots(scenario: ScenarioView, names: list[str]) -> list[str]:
     """The robots whose software localizes by measured poses on ``/<robot>/pose``."""
-    cfg = scenario.mocap
+    cfg = scenario.section(MocapConfig)
     if cfg.source == "simulated":
         tracked = simulated_robots(scenario, names)
     else:
         tracked = [robot for robot, _ in external_bodies(scenario, names)]
-    if scenario.physical.pose == "odom":
-        tracked += [r for r in scenario.physical.robots if r not in tracked]
+    if scenario.section(PhysicalConfig).pose == "odom":
+        tracked += [r for r in scenario.section(PhysicalConfig).robots if r not in tracked]
     return [name for name in names if name in tracked]

@@ -53,51 +53,29 @@ stalled) gave 4 in 20 seeds instead of 5: no better than chance, so not kept.
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
-from cosim.errors import ConfigError
+from adapters.navigation.places import (
+    APPROACH,
+    ARRIVE_M,
+    GAP_M,
+    MOVE,
+    RELEASE_M,
+    SETTLE,
+    STAND,
+    VIA_M,
+    FleetPlaces,
+)
+from cosim.core.errors import ConfigError
+from cosim.core.timebase import s_to_ns
 from cosim.scenario.model import Scenario
-from cosim.timebase import s_to_ns
 from models.arrays import BoolArray, FloatArray, IntArray, UInt8Array
-from models.errors import ModelError
-from models.kinematics import DriveLimits
 from models.navigation.costmap import StaticCostmap
 from models.navigation.pibt import Pibt
-from models.navigation.place_drive import place_drive
-from models.navigation.roadmap import (
-    UNREACHABLE,
-    Int32Array,
-    Roadmap,
-    build_roadmap,
-    one_way,
-    one_way_floor,
-    segment_clear,
-)
 
-GAP_M = 0.14
-"""Gap between two robots standing on neighbouring places (m): spacing is 2 r + gap (0.8 m
-for Jackals, a third of the 2.4 m pitch of the paper's rows of racks)."""
-CLEARANCE_M = 0.1
-"""Margin between a place, or the straight way between two, and a static obstacle (m)."""
-ARRIVE_M = 0.45
-"""A robot this close to the place it drives to stands on it and takes its next step (m)."""
-RELEASE_M = 0.5
-"""A robot lets go of the place it left once this far from its centre (m); a robot
-driving in stops for it (:func:`~models.navigation.place_drive.place_drive`) if it is
-slow to leave. Goals given up in fleet50, seeds 1-4 x 300 s: 0.4 m 45, 0.5 m 4, 0.55 m 13,
-0.6 m 25; 0.73 m (its body clear of a robot standing there; with ``ARRIVE_M`` 0.3) 11, with
-7 % fewer arrivals."""
 URGENT_S = 10.0
 """A robot with no progress for this long goes first (s). Goals given up as above (with
 ``RELEASE_M`` 0.73, ``ARRIVE_M`` 0.3): 3 s 22, 6 s 14, 10 s 11, 20 s 41; the goal's age
 alone (PIBT's rule) 32; the time since progress alone 23."""
-GOAL_REACH = 2.0
-"""A goal is reached from a place at most this many spacings away."""
-VIA_M = 0.03
-"""A robot this close to the centre of the place it turns on has passed it (m)."""
-STAND, MOVE, APPROACH, SETTLE = 0, 1, 2, 3
-"""What a robot does: stands on its place, drives to its next place, drives from its
-goal's place to the goal, drives back onto its place (after the goal, or at the start)."""
 
 
 def check_localization(scenario: Scenario, tracked: BoolArray) -> None:
@@ -140,7 +118,7 @@ def check_localization(scenario: Scenario, tracked: BoolArray) -> None:
 
 
 class FleetTraffic:
-    """Places, holds and PIBT steps for the whole fleet.
+    """PIBT steps for the whole fleet over its places (:class:`FleetPlaces`).
 
     Args:
         static: the building's static costmap.
@@ -156,105 +134,8 @@ class FleetTraffic:
     def __init__(
         self, static: StaticCostmap, lanes: UInt8Array, poses: FloatArray, radius_m: float
     ) -> None:
-        self.radius_m = radius_m
-        self.footprint_clear = static.distance_m >= radius_m  # cells a robot centre may be on
-        self.grid = (static.origin_xy_m, static.resolution_m)
-        self.spacing_m = 2 * radius_m + GAP_M
-        self.reach_m = 2 * radius_m + GAP_M / 2  # places a robot at a point touches
-        self.roadmap: Roadmap = build_roadmap(
-            static.distance_m,
-            static.origin_xy_m,
-            static.resolution_m,
-            self.spacing_m,
-            radius_m + CLEARANCE_M,
-        )
-        self.roadmap = one_way(self.roadmap, lanes, static.origin_xy_m, static.resolution_m)
-        self.roadmap = one_way_floor(self.roadmap, lanes, static.origin_xy_m, static.resolution_m)
-        n = len(poses)
-        self.node = self._start_places(poses)
-        self.mode = np.full(n, SETTLE, dtype=np.int64)
-        self.held: list[list[int]] = [self._touched(poses[i], int(self.node[i])) for i in range(n)]
-        self.aim = self.roadmap.xy[self.node].copy()
-        self.came_from = self.node.copy()  # the place a robot standing on its place came from
-        self.via = np.full((n, 2), np.nan)  # a place's centre to pass before turning off
-        self.goal = np.full((n, 2), np.nan)
-        self.goal_node = np.full(n, -1, dtype=np.int64)
-        self.since_ns = np.zeros(n, dtype=np.int64)
-        self.returning = np.zeros(n, dtype=bool)  # let a robot through off its goal's place
-        self.hops: dict[int, Int32Array] = {}
+        self.places = FleetPlaces(static, lanes, poses, radius_m)
 
-    def _start_places(self, xy: FloatArray) -> IntArray:
-        """A distinct place for every robot, nearest overall.
-
-        A Hungarian assignment among the places near the robots.
-        """
-        rm = self.roadmap
-        if len(xy) > len(rm):
-            raise ModelError(
-                "robots.count", len(xy), f"at most {len(rm)} robots: the places of traffic 'pibt'"
-            )
-        near = np.unique(rm.nearest_k(xy, min(len(rm), 9)))
-        d = np.hypot(*(xy[:, None, :] - rm.xy[near][None, :, :]).transpose(2, 0, 1))
-        _, cols = linear_sum_assignment(d)
-        places: IntArray = near[cols].astype(np.int64)
-        return places
-
-    def _touched(self, point: FloatArray, node: int) -> list[int]:
-        """``node`` and every place a robot driving from it to ``point`` comes too close to."""
-        start = self.roadmap.xy[node]
-        steps = max(2, int(np.ceil(np.hypot(*(point - start)) / 0.1)) + 1)
-        found: list[int] = [node]
-        for t in np.linspace(0.0, 1.0, steps):
-            for u in self.roadmap.near(start + t * (point - start), self.reach_m):
-                if u not in found:
-                    found.append(u)
-        return found
-
-    def _hops(self, goal: int) -> Int32Array:
-        """Hops from every place to place ``goal`` (cached per goal place)."""
-        found = self.hops.get(goal)
-        if found is None:
-            found = self.roadmap.hops_to(goal)
-            self.hops[goal] = found
-        return found
-
-    # -- goals --------------------------------------------------------------------------
-    def goal_place(self, i: int, goal: FloatArray) -> int:
-        """The place robot ``i`` reaches ``goal`` from, or -1 if none.
-
-        The nearest of robot ``i``'s places within :data:`GOAL_REACH` spacings of the goal
-        from which the straight way to the goal keeps the footprint off static obstacles.
-        """
-        rm = self.roadmap
-        mine = rm.component[self.node[i]]
-        near = [u for u in rm.near(goal, GOAL_REACH * rm.spacing_m) if rm.component[u] == mine]
-        near.sort(key=lambda u: (float(np.hypot(*(rm.xy[u] - goal))), u))  # ties: lowest first
-        for u in near:
-            if segment_clear(self.footprint_clear, rm.xy[u][None], goal[None], *self.grid)[0]:
-                return int(u)
-        return -1
-
-    def set_goal(self, i: int, goal: FloatArray, place: int, now_ns: int) -> None:
-        """Robot ``i`` drives to ``goal`` (m) by way of ``place`` from now."""
-        self.end_goal(i)
-        self.goal[i] = goal
-        self.goal_node[i] = place
-        self.since_ns[i] = now_ns
-
-    def way_left(self, i: int, xy: FloatArray) -> float:
-        """Robot ``i``'s way (m) from ``xy`` to its goal along the places (inf if none)."""
-        return float(self._ways(np.asarray(xy, dtype=float)[None], np.array([i]))[0])
-
-    def end_goal(self, i: int) -> None:
-        """Robot ``i``'s goal is reached, dropped or cancelled: it settles on its place."""
-        self.goal[i] = np.nan
-        self.goal_node[i] = -1
-        self.returning[i] = False
-        if self.mode[i] == APPROACH:
-            self.mode[i] = SETTLE
-            self.aim[i] = self.roadmap.xy[self.node[i]]
-
-    # -- the step -------------------------------------------------------------------------
     def step(
         self, poses: FloatArray, active: BoolArray, progress_ns: IntArray, now_ns: int
     ) -> tuple[FloatArray, FloatArray]:
@@ -270,41 +151,42 @@ class FleetTraffic:
             The (n, 2) point each robot drives to now (m, ``map``), and the (n,) way left
             to each goal along the places (m).
         """
-        rm = self.roadmap
+        places = self.places
+        rm = places.roadmap
         xy = poses[:, :2]
-        passed = np.hypot(*(xy - self.via).T) < VIA_M
-        self.via[passed] = np.nan
-        gap = np.hypot(*(xy - self.aim).T)
-        moving = (self.mode == MOVE) | (self.mode == SETTLE)
-        landed = moving & np.isnan(self.via[:, 0]) & (gap <= ARRIVE_M)
-        self.mode[landed] = STAND
-        self._release(xy)
-        standing = np.flatnonzero(self.mode == STAND)
+        passed = np.hypot(*(xy - places.via).T) < VIA_M
+        places.via[passed] = np.nan
+        gap = np.hypot(*(xy - places.aim).T)
+        moving = (places.mode == MOVE) | (places.mode == SETTLE)
+        landed = moving & np.isnan(places.via[:, 0]) & (gap <= ARRIVE_M)
+        places.mode[landed] = STAND
+        places.release(xy)
+        standing = np.flatnonzero(places.mode == STAND)
         # held places and their holders (-1: several); a robot may go back to a place
         # only its own body still covers (it made way, or turns back)
         held: dict[int, int] = {}
         leaving: set[int] = set()  # places robots have left, their bodies still over them
-        mode = self.mode.tolist()
+        mode = places.mode.tolist()
         for i in range(len(xy)):
-            node = int(self.node[i])
-            mine = self.held[i] if mode[i] == STAND else [*self.held[i], node]
+            node = int(places.node[i])
+            mine = places.held[i] if mode[i] == STAND else [*places.held[i], node]
             for u in mine:
                 held[u] = i if held.get(u, i) == i else -1
             if mode[i] == MOVE or mode[i] == STAND:
-                leaving.update(u for u in self.held[i] if u != node)
-        at = {int(i): int(self.node[i]) for i in standing}
+                leaving.update(u for u in places.held[i] if u != node)
+        at = {int(i): int(places.node[i]) for i in standing}
         occupied = set(at.values())
         for u in occupied:
             held.pop(u, None)
-        goal_node = self.goal_node
+        goal_node = places.goal_node
 
         def rank(robot: int, u: int) -> tuple[float, ...]:
             here = at[robot]
             if goal_node[robot] < 0:  # no goal: keep to its place, make way when asked
                 return (0.0 if u == here else 1.0, float(u in occupied), float(u))
-            hops = float(self._hops(int(goal_node[robot]))[u])
+            hops = float(places.hops_to(int(goal_node[robot]))[u])
             # among equally short ways: a free place, then straight on (a turn is a stop)
-            heading = rm.xy[here] - rm.xy[self.came_from[robot]]
+            heading = rm.xy[here] - rm.xy[places.came_from[robot]]
             turn = float(u != here and float(np.dot(heading, rm.xy[u] - rm.xy[here])) <= 0.0)
             return (hops, float(u in occupied and u != here), turn, float(u))
 
@@ -314,69 +196,43 @@ class FleetTraffic:
         for i in order:
             if i in pibt.nxt:
                 continue
-            if goal_node[i] == self.node[i]:
+            if goal_node[i] == places.node[i]:
                 self._approach(pibt, i)
             else:
                 pibt.move(i)
         for i, u in pibt.nxt.items():
-            if self.mode[i] == APPROACH:
+            if places.mode[i] == APPROACH:
                 continue
-            here = int(self.node[i])
+            here = int(places.node[i])
             if u != here:
-                heading = rm.xy[here] - rm.xy[self.came_from[i]]
+                heading = rm.xy[here] - rm.xy[places.came_from[i]]
                 step = rm.xy[u] - rm.xy[here]
                 off = xy[i] - rm.xy[here]
                 aside = abs(step[0] * off[1] - step[1] * off[0]) / rm.spacing_m
-                turn = self.came_from[i] == here or not np.allclose(heading, step)
+                turn = places.came_from[i] == here or not np.allclose(heading, step)
                 if turn or aside > VIA_M:
                     # a turn, or a robot off the line (after settling): through the centre,
                     # no corner cut (a cut corner passes within reach of the next place)
-                    self.via[i] = rm.xy[here]
+                    places.via[i] = rm.xy[here]
                 # the places its body still covers stay held (as after a goal's approach)
                 under = [
                     v
-                    for v in self.held[i]
+                    for v in places.held[i]
                     if v != here and np.hypot(*(xy[i] - rm.xy[v])) < RELEASE_M
                 ]
-                self.held[i] = [here, *under]
-                self.came_from[i] = here
-                self.node[i] = u
-                self.mode[i] = MOVE
-            self.aim[i] = rm.xy[u]
-        drive = np.where(np.isnan(self.via), self.aim, self.via)
+                places.held[i] = [here, *under]
+                places.came_from[i] = here
+                places.node[i] = u
+                places.mode[i] = MOVE
+            places.aim[i] = rm.xy[u]
+        drive = np.where(np.isnan(places.via), places.aim, places.via)
         # a robot whose next place another robot's body still covers waits on its own
-        owner = {u: j for j in range(len(xy)) for u in self.held[j]}
-        for i in np.flatnonzero(self.mode == MOVE).tolist():
-            j = owner.get(int(self.node[i]))
+        owner = {u: j for j in range(len(xy)) for u in places.held[j]}
+        for i in np.flatnonzero(places.mode == MOVE).tolist():
+            j = owner.get(int(places.node[i]))
             if j is not None and j != i:
-                drive[i] = rm.xy[self.came_from[i]]
-        return drive, self._remaining(xy, active)
-
-    def commands(
-        self,
-        poses: FloatArray,
-        points: FloatArray,
-        settle: tuple[FloatArray, FloatArray, BoolArray] | None,
-        free_m: FloatArray,
-        limits: DriveLimits,
-    ) -> tuple[FloatArray, FloatArray]:
-        """Speed and yaw-rate commands: straight from place to place.
-
-        See :func:`~models.navigation.place_drive.place_drive`. Robots settling onto a
-        place from off it (at the start, after a goal) take the local controller's speed
-        and yaw rate from ``settle`` (needed when any robot is :attr:`settling`).
-        """
-        v, w = place_drive(poses, points, limits, free_m)
-        if settle is None:
-            return v, w
-        settling = self.settling
-        return np.where(settling, settle[0], v), np.where(settling, settle[1], w)
-
-    @property
-    def settling(self) -> BoolArray:
-        """(n,) robots settling onto a place from off it."""
-        settling: BoolArray = self.mode == SETTLE
-        return settling
+                drive[i] = rm.xy[places.came_from[i]]
+        return drive, places.remaining(xy, active)
 
     def _order(
         self, standing: IntArray, active: BoolArray, progress_ns: IntArray, now_ns: int
@@ -386,33 +242,22 @@ class FleetTraffic:
         Stalled for :data:`URGENT_S` (longest first), then by the goal's age, then those
         without a goal.
         """
-        with_goal = standing[active[standing] & (self.goal_node[standing] >= 0)]
+        places = self.places
+        with_goal = standing[active[standing] & (places.goal_node[standing] >= 0)]
         stalled = now_ns - progress_ns[with_goal] >= s_to_ns(URGENT_S)
         first = np.where(stalled, progress_ns[with_goal], now_ns)
-        there = self.goal_node[with_goal] == self.node[with_goal]
+        there = places.goal_node[with_goal] == places.node[with_goal]
         order: list[int] = with_goal[
-            np.lexsort((with_goal, self.since_ns[with_goal], first, ~there))
+            np.lexsort((with_goal, places.since_ns[with_goal], first, ~there))
         ].tolist()
         planned = set(order)
         return order + [int(i) for i in standing.tolist() if int(i) not in planned]
 
-    def _release(self, xy: FloatArray) -> None:
-        """Let go of the places a robot's body has left (all but its own place)."""
-        rm = self.roadmap
-        for i in range(len(xy)):
-            if not self.held[i] or self.mode[i] == APPROACH:
-                continue
-            keep = [
-                u
-                for u in self.held[i]
-                if u == self.node[i] or np.hypot(*(xy[i] - rm.xy[u])) < RELEASE_M
-            ]
-            self.held[i] = keep
-
     def _approach(self, pibt: Pibt, i: int) -> None:
         """Robot ``i`` on its goal's place claims what its body touches at the goal."""
-        here = int(self.node[i])
-        touched = self._touched(self.goal[i], here)
+        places = self.places
+        here = int(places.node[i])
+        touched = places.touched(places.goal[i], here)
         if not all(pibt.free(u, i) or u == here for u in touched):
             pibt.move(i)  # a robot drives through: wait (or make way) this step
             if pibt.nxt.get(i) == here:  # it waits: no one else moves in meanwhile
@@ -435,14 +280,14 @@ class FleetTraffic:
             stuck = [o for o in pushed if pibt.nxt.get(o) == pibt.at[o]]
             if stuck:
                 pibt.let_through(i, stuck[0])
-                self.returning[i] = pibt.nxt.get(i) != here
+                places.returning[i] = pibt.nxt.get(i) != here
             else:
                 self._keep(pibt, i, touched)
             return
-        self.mode[i] = APPROACH
-        self.held[i] = touched
-        self.aim[i] = self.goal[i]
-        self.via[i] = self.roadmap.xy[here]
+        places.mode[i] = APPROACH
+        places.held[i] = touched
+        places.aim[i] = places.goal[i]
+        places.via[i] = places.roadmap.xy[here]
 
     def _keep_for_returning(self, pibt: Pibt) -> None:
         """Robots that let a robot through off their goal's place keep what they need there.
@@ -452,13 +297,14 @@ class FleetTraffic:
         while it comes back. Only while it is one step from the place; standing on it
         again, it approaches or waits as any robot there.
         """
-        for i in np.flatnonzero(self.returning).tolist():
-            goal = int(self.goal_node[i])
-            back = self.node[i] == goal and self.mode[i] == STAND
-            if back or goal < 0 or self._hops(goal)[self.node[i]] > 1:
-                self.returning[i] = False
+        places = self.places
+        for i in np.flatnonzero(places.returning).tolist():
+            goal = int(places.goal_node[i])
+            back = places.node[i] == goal and places.mode[i] == STAND
+            if back or goal < 0 or places.hops_to(goal)[places.node[i]] > 1:
+                places.returning[i] = False
                 continue
-            self._keep(pibt, i, self._touched(self.goal[i], goal))
+            self._keep(pibt, i, places.touched(places.goal[i], goal))
 
     @staticmethod
     def _keep(pibt: Pibt, i: int, touched: list[int]) -> None:
@@ -466,34 +312,3 @@ class FleetTraffic:
         for u in touched[1:]:
             if pibt.free(u, i) and pibt.occupant(u) is None:
                 pibt.claim(i, u)
-
-    def _remaining(self, xy: FloatArray, active: BoolArray) -> FloatArray:
-        """Way left to each goal (m), 0 for robots without one (see :meth:`_ways`)."""
-        out = np.zeros(len(xy))
-        going = np.flatnonzero(active & (self.goal_node >= 0))
-        if len(going):
-            out[going] = self._ways(xy[going], going)
-        return out
-
-    def _ways(self, xy: FloatArray, robots: IntArray) -> FloatArray:
-        """Way left (m) of ``robots`` standing at ``xy`` (a row each).
-
-        To the next place, along the places, to the goal; straight to the goal while
-        approaching it.
-        """
-        rm = self.roadmap
-        goal_node = self.goal_node[robots]
-        hops = np.array(
-            [self._hops(int(g))[u] for g, u in zip(goal_node, self.node[robots], strict=True)],
-            dtype=float,
-        )
-        hops[hops == UNREACHABLE] = np.inf
-        goal = self.goal[robots]
-        along = (
-            np.hypot(*(xy - self.aim[robots]).T)
-            + hops * rm.spacing_m
-            + np.hypot(*(rm.xy[goal_node] - goal).T)
-        )
-        approaching = self.mode[robots] == APPROACH
-        ways: FloatArray = np.where(approaching, np.hypot(*(xy - goal).T), along)
-        return ways

@@ -18,12 +18,13 @@ import numpy as np
 from scipy import ndimage
 
 from adapters.naming import topic
-from cosim.adapter import RunContext
-from cosim.bus import Envelope
-from cosim.errors import ConfigError
-from cosim.hosts import HostId
-from cosim.messages import Message, NavGoal, NavStatus
-from cosim.timebase import s_to_ns
+from cosim.core.adapter import RunContext
+from cosim.core.bus import Envelope
+from cosim.core.errors import ConfigError
+from cosim.core.hosts import HostId
+from cosim.core.messages import Message, NavGoal, NavStatus
+from cosim.core.timebase import s_to_ns
+from cosim.scenario.sections import NavigationConfig, RobotsConfig, WorldConfig
 from models.kinematics import FleetState
 from models.navigation.costmap import StaticCostmap
 
@@ -44,7 +45,7 @@ class GoalsAdapter:
         self.names = list(fleet.names)
         self.hosts = [HostId(n) for n in self.names]
         static = run.service(StaticCostmap)
-        radius = run.scenario.robots.radius_m
+        radius = run.settings(RobotsConfig).radius_m
         free = static.distance_m >= radius + GOAL_CLEARANCE_M
         labels, _ = ndimage.label(static.cost < 253, structure=np.ones((3, 3)))
         self.static = static
@@ -58,8 +59,8 @@ class GoalsAdapter:
             if label not in by_region:
                 by_region[label] = np.argwhere(free & (labels == label))  # (k, 2) as (iy, ix)
             self.cells.append(by_region[label])
-        width, height = run.scenario.world.size_m
-        for x, y in run.scenario.navigation.goals:
+        width, height = run.settings(WorldConfig).size_m
+        for x, y in run.settings(NavigationConfig).goals:
             if not (0 <= x <= width and 0 <= y <= height):
                 raise ConfigError(
                     f"{run.scenario.source}: [navigation] goals has [{x:g}, {y:g}]: expected "
@@ -101,7 +102,7 @@ class GoalsAdapter:
         return on_status
 
     def _send(self, run: RunContext, i: int) -> None:
-        series = run.scenario.navigation.goals
+        series = run.settings(NavigationConfig).goals
         if series:
             x, y = series[(i + int(self.next_id[i])) % len(series)]
             self._publish(run, i, x, y)

@@ -14,7 +14,11 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from cosim.messages import OccupancyGrid as GridMessage
+from adapters.mapping.geometry import map_geometry, unknown_grid
+from cosim.core.adapter import RunContext
+from cosim.core.messages import OccupancyGrid as GridMessage
+from cosim.scenario.mapping import MappingConfig
+from cosim.scenario.sections import NavigationConfig
 from models.navigation.costmap import CostmapParams, StaticCostmap
 from models.navigation.lanes import TWO_WAY, aisle_lanes
 from models.occupancy import (
@@ -22,9 +26,11 @@ from models.occupancy import (
     OCCUPIED,
     UNKNOWN,
     OccupancyGrid,
+    ground_truth_grid,
     resample,
     resampled_obstacles,
 )
+from models.world import Warehouse
 
 
 class StaticLayer:
@@ -126,3 +132,26 @@ def lanes_on(layer: StaticCostmap, truth: OccupancyGrid, width_m: float) -> npt.
     placed = np.full(layer.cost.shape, TWO_WAY, dtype=np.uint8)
     placed[oy : oy + rows, ox : ox + cols] = lanes
     return placed
+
+
+def static_costmap(run: RunContext, radius_m: float) -> StaticCostmap:
+    """The building's static map, inflated for a footprint of ``radius_m`` (m).
+
+    The :class:`StaticLayer` service if an adapter provides one, else the ground-truth
+    map at ``navigation.resolution_m`` (provided from now on).
+    """
+    cfg = run.settings(NavigationConfig)
+    if not run.has_service(StaticLayer):
+        run.provide(StaticLayer(ground_truth_grid(run.service(Warehouse), cfg.resolution_m)))
+    params = CostmapParams(radius_m, cfg.inflation_radius_m, cfg.cost_scaling)
+    return StaticCostmap.from_grid(run.service(StaticLayer).grid, params)
+
+
+def robot_layers(run: RunContext, static: StaticCostmap, robots: int) -> StaticLayers:
+    """The static layer each robot plans on: the shared one, or its own map as it builds it."""
+    mapping = run.settings(MappingConfig)
+    if not mapping.enabled:
+        return StaticLayers.shared(static, robots)
+    area = map_geometry(run.service(Warehouse), mapping.resolution_m)
+    resolution_m = run.settings(NavigationConfig).resolution_m
+    return StaticLayers.unexplored(unknown_grid(area), robots, static.params, resolution_m)

@@ -17,13 +17,13 @@ import time
 import numpy as np
 
 from adapters.navigation.layers import StaticLayers
-from adapters.navigation.records import NavRecords
 from adapters.navigation.robots_layer import RobotsLayer
 from adapters.navigation.scan_memory import MovingMemory, ScanMemory
-from cosim.adapter import RunContext
-from cosim.hosts import HostId
-from cosim.messages import Path
-from cosim.timebase import period_ns
+from adapters.navigation.tables import NavRecords
+from cosim.core.adapter import RunContext
+from cosim.core.hosts import HostId
+from cosim.core.messages import Path
+from cosim.core.timebase import period_ns
 from models.arrays import FloatArray
 from models.navigation.costmap import StaticCostmap, with_obstacles
 from models.navigation.follow import PathBook, paths_blocked

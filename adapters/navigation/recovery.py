@@ -15,7 +15,7 @@ from collections.abc import Callable
 import numpy as np
 
 from adapters.navigation.scan_memory import ScanMemory
-from cosim.timebase import s_to_ns
+from cosim.core.timebase import s_to_ns
 from models.arrays import BoolArray, FloatArray
 from models.kinematics import DriveLimits
 

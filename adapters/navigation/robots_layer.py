@@ -1,6 +1,6 @@
 """The robots layer: every robot's pose and footprint broadcast over the network.
 
-With ``navigation.robots_layer`` each robot publishes a :class:`~cosim.messages.RobotState`
+With ``navigation.robots_layer`` each robot publishes a :class:`~cosim.core.messages.RobotState`
 on ``/fleet/robot_states`` at ``robots_layer_hz`` (latency and loss apply), and each keeps
 what it last heard from the others; a robot not heard from for ``robots_layer_timeout_s``
 is forgotten. The global planner and the local controller avoid the discs it knows.
@@ -12,12 +12,12 @@ from collections.abc import Callable
 
 import numpy as np
 
-from cosim.adapter import RunContext
-from cosim.bus import Envelope
-from cosim.hosts import HostId
-from cosim.kernel import Stage
-from cosim.messages import Message, RobotState
-from cosim.timebase import period_ns, s_to_ns
+from cosim.core.adapter import RunContext
+from cosim.core.bus import Envelope
+from cosim.core.hosts import HostId
+from cosim.core.kernel import Stage
+from cosim.core.messages import Message, RobotState
+from cosim.core.timebase import period_ns, s_to_ns
 from models.arrays import FloatArray, IntArray
 
 ROBOT_STATES = "/fleet/robot_states"

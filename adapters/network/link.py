@@ -18,12 +18,13 @@ from typing import Any, ClassVar
 import numpy as np
 
 from adapters.network.setup import build_model, build_topology, partitions_of
-from cosim.adapter import RunContext
-from cosim.errors import ConfigError
-from cosim.hosts import HostId, HostKind
-from cosim.kernel import Stage
-from cosim.link import AllDelivered, DeliveryStatus, Transfer
-from cosim.timebase import NS_PER_S, period_ns
+from cosim.core.adapter import RunContext
+from cosim.core.errors import ConfigError
+from cosim.core.hosts import HostId, HostKind
+from cosim.core.kernel import Stage
+from cosim.core.link import AllDelivered, DeliveryStatus, Transfer
+from cosim.core.timebase import NS_PER_S, period_ns
+from cosim.scenario.network import NetworkConfig
 from models.kinematics import FleetState
 from models.network.fate import Fate
 from models.network.model import NetworkModel, Partition
@@ -34,7 +35,7 @@ _STATUS = {fate: DeliveryStatus(fate.value) for fate in Fate}
 
 
 class NetworkLink:
-    """The bus's :class:`cosim.link.Link`, backed by the network model."""
+    """The bus's :class:`cosim.core.link.Link`, backed by the network model."""
 
     def __init__(self, model: NetworkModel, distance_m: Callable[[str, str], float | None]):
         self.model = model
@@ -89,7 +90,7 @@ class NetworkAdapter:
     requires: ClassVar[tuple[str, ...]] = ("world", "fleet")
 
     def __init__(self, run: RunContext) -> None:
-        cfg = run.scenario.network
+        cfg = run.settings(NetworkConfig)
         self.fleet = run.service(FleetState)
         self.robots = list(self.fleet.names)
         self._index = {name: i for i, name in enumerate(self.robots)}

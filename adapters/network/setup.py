@@ -5,10 +5,10 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import TypeVar
 
-from cosim.adapter import RunContext
-from cosim.errors import ConfigError
+from cosim.core.adapter import RunContext
+from cosim.core.timebase import s_to_ns
+from cosim.scenario.fields import model_problem
 from cosim.scenario.network import NetworkConfig
-from cosim.timebase import s_to_ns
 from models.errors import ModelError
 from models.network.latency import (
     ConstantLatency,
@@ -32,14 +32,11 @@ T = TypeVar("T")
 
 
 def _checked(source: str, make: Callable[[], T]) -> T:
-    """Run a model constructor, turning its ModelError into a ConfigError naming the file."""
+    """Run a model constructor, turning its ModelError into one line naming the file."""
     try:
         return make()
     except ModelError as error:
-        section, _, key = error.key.partition(".")
-        raise ConfigError(
-            f"{source}: [{section}] {key} = {error.value!r}: expected {error.expected}"
-        ) from None
+        raise model_problem(source, error) from None
 
 
 def _latency(cfg: NetworkConfig) -> LatencyModel:

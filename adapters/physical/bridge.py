@@ -1,7 +1,7 @@
 """The physical-robot bridge: a real ROS 2 robot's twin in the run, over DDS.
 
 For each robot in ``physical.robots`` (ROS 2 topic names; DDS names and QoS as
-rmw_cyclonedds maps them, see :mod:`cosim.ros2dds`):
+rmw_cyclonedds maps them, see :mod:`adapters.ros2dds`):
 
 * in: its pose, from the mocap source (``physical.pose = "mocap"``, handled by the mocap
   adapter) or its own ``/<robot>/odom`` (nav_msgs/Odometry, sensor-data QoS; its odometry
@@ -27,17 +27,18 @@ from typing import Any, ClassVar
 from adapters.mocap.intake import PoseIntake
 from adapters.mocap.tracking import physical_robots
 from adapters.naming import topic
-from adapters.physical.session import DdsSession, dds_session
-from cosim.adapter import RunContext
-from cosim.bus import Envelope
-from cosim.hosts import HostId
-from cosim.kernel import Stage
-from cosim.messages import LaserScan, Message, PoseStamped, Twist
-from cosim.messages.navigation import NavGoal
-from cosim.ros2dds import types as dds
-from cosim.ros2dds.participant import Publisher, Subscription
-from cosim.ros2dds.qos import QosKind
-from cosim.timebase import period_ns
+from adapters.ros2dds import types as dds
+from adapters.ros2dds.participant import Publisher, Subscription
+from adapters.ros2dds.qos import QosKind
+from adapters.ros2dds.session import DdsSession, dds_session
+from cosim.core.adapter import RunContext
+from cosim.core.bus import Envelope
+from cosim.core.hosts import HostId
+from cosim.core.kernel import Stage
+from cosim.core.messages import LaserScan, Message, PoseStamped, Twist
+from cosim.core.messages.navigation import NavGoal
+from cosim.core.timebase import period_ns
+from cosim.scenario.mixed import PhysicalConfig
 from models.kinematics import FleetState
 
 
@@ -63,7 +64,7 @@ class PhysicalAdapter:
     requires: ClassVar[tuple[str, ...]] = ("fleet", "lidar")
 
     def __init__(self, run: RunContext) -> None:
-        self.cfg = run.scenario.physical
+        self.cfg = run.settings(PhysicalConfig)
         fleet = run.service(FleetState)
         names = list(fleet.names)
         self.robots = [

@@ -10,9 +10,10 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from typing import Any, ClassVar
 
-from cosim.adapter import RunContext
-from cosim.kernel import Stage
-from cosim.timebase import NS_PER_S, period_ns
+from cosim.core.adapter import RunContext
+from cosim.core.kernel import Stage
+from cosim.core.timebase import NS_PER_S, period_ns
+from cosim.scenario.sections import RecordConfig
 from models.kinematics import FleetState
 
 POSE_COLUMNS = ("t_s", "robot", "x_m", "y_m", "yaw_rad", "v_mps", "w_radps")
@@ -27,7 +28,7 @@ class PosesAdapter:
     def __init__(self, run: RunContext) -> None:
         self.fleet = run.service(FleetState)
         self.table = run.recorder.table("poses", POSE_COLUMNS, categorical=("robot",))
-        self.period_ns = period_ns(run.scenario.record.pose_rate_hz)
+        self.period_ns = period_ns(run.settings(RecordConfig).pose_rate_hz)
         self._listeners: list[Callable[[int], None]] = []
         run.provide(self)
 

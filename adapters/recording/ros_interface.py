@@ -33,13 +33,13 @@ import numpy as np
 
 from adapters.assignment.topics import TASKS
 from adapters.fleet.motion import FleetAdapter
-from adapters.humans.traffic import People
+from adapters.humans.people import People
 from adapters.naming import topic
 from adapters.recording.poses import PosesAdapter
-from cosim.adapter import RunContext
-from cosim.bus import TopicQos
-from cosim.hosts import BASE_HOST
-from cosim.messages import (
+from cosim.core.adapter import RunContext
+from cosim.core.bus import TopicQos
+from cosim.core.hosts import BASE_HOST
+from cosim.core.messages import (
     Clock,
     Marker,
     MarkerArray,
@@ -51,7 +51,8 @@ from cosim.messages import (
     TFMessage,
     Transform,
 )
-from cosim.messages.scene import RGBA, MarkerAction
+from cosim.core.messages.scene import RGBA, MarkerAction
+from cosim.scenario.sections import RobotsConfig
 from models.kinematics import FleetState
 from models.occupancy import ground_truth_grid
 from models.world import Warehouse
@@ -93,7 +94,7 @@ class RosInterfaceAdapter:
         self.names = list(self.fleet.names)
         self.truth_topics = [topic(n, "ground_truth") for n in self.names]
         self.frames = [(f"{n}/odom", f"{n}/base_link") for n in self.names]
-        self.radius_m = run.scenario.robots.radius_m
+        self.radius_m = run.settings(RobotsConfig).radius_m
         self.static_markers = self._static_markers()
         self._shown: tuple[tuple[int, str], ...] | None = None
         bus = run.bus

@@ -15,13 +15,14 @@ from typing import Any, ClassVar
 import numpy as np
 
 from adapters.naming import topic
-from cosim.adapter import RunContext
-from cosim.bus import TopicQos
-from cosim.hosts import HostId
-from cosim.kernel import Stage
-from cosim.messages import LaserScan
-from cosim.rng import BlockDraws
-from cosim.timebase import period_ns
+from cosim.core.adapter import RunContext
+from cosim.core.bus import TopicQos
+from cosim.core.hosts import HostId
+from cosim.core.kernel import Stage
+from cosim.core.messages import LaserScan
+from cosim.core.rng import BlockDraws
+from cosim.core.timebase import period_ns
+from cosim.scenario.sections import LidarConfig
 from models.kinematics import FleetState
 from models.lidar import ScanGeometry, apply_sensor_model
 from models.obstacles import DynamicObstacles
@@ -36,7 +37,7 @@ class LidarAdapter:
     requires: ClassVar[tuple[str, ...]] = ("world", "fleet")
 
     def __init__(self, run: RunContext) -> None:
-        cfg = run.scenario.lidar
+        cfg = run.settings(LidarConfig)
         self.geometry = ScanGeometry(
             beams=cfg.beams,
             fov_rad=math.radians(cfg.fov_deg),

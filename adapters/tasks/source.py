@@ -2,7 +2,7 @@
 
 It opens ``tasks.initial`` tasks at pick stations (shelf faces) at the start and a new one
 whenever one is completed (as in the paper), up to ``tasks.max_total``. The open tasks
-are broadcast as a :class:`~cosim.messages.TaskSet` over the network whenever they change
+are broadcast as a :class:`~cosim.core.messages.TaskSet` over the network whenever they change
 (a new *epoch*) and every ``assignment.rebroadcast_s``. It keeps the book of claims and is
 the one authority on service: a robot at a task asks for the right to serve it, and only
 one robot ever gets it (see :mod:`models.tasks.book`). With ``assignment.protocol =
@@ -28,12 +28,12 @@ from adapters.assignment.topics import (
     order_topic,
     reply_topic,
 )
-from cosim.adapter import RunContext
-from cosim.bus import Envelope
-from cosim.errors import ScenarioError
-from cosim.hosts import BASE_HOST
-from cosim.kernel import Stage
-from cosim.messages import (
+from cosim.core.adapter import RunContext
+from cosim.core.bus import Envelope
+from cosim.core.errors import ScenarioError
+from cosim.core.hosts import BASE_HOST
+from cosim.core.kernel import Stage
+from cosim.core.messages import (
     Message,
     RobotState,
     ServiceReply,
@@ -44,7 +44,8 @@ from cosim.messages import (
     TaskOrder,
     TaskSet,
 )
-from cosim.timebase import NS_PER_S, period_ns, s_to_ns
+from cosim.core.timebase import NS_PER_S, period_ns, s_to_ns
+from cosim.scenario.sections import AssignmentConfig, RobotsConfig, TasksConfig, WorldConfig
 from models.assignment.problem import AssignmentProblem, hungarian
 from models.kinematics import FleetState
 from models.navigation.costmap import INSCRIBED, StaticCostmap
@@ -74,15 +75,16 @@ class TaskSourceAdapter:
     requires: ClassVar[tuple[str, ...]] = ("world", "fleet", "network", "navigation")
 
     def __init__(self, run: RunContext) -> None:
-        self.cfg = run.scenario.tasks
-        self.assignment = run.scenario.assignment
+        self.cfg = run.settings(TasksConfig)
+        self.assignment = run.settings(AssignmentConfig)
         world = run.service(Warehouse)
         fleet = run.service(FleetState)
         self.robots = list(fleet.names)
         self.stations = _reachable_stations(run, world, run.service(StaticCostmap), fleet)
         if not len(self.stations):
             raise ScenarioError(
-                f"{run.scenario.source}: world.shelf_count = {run.scenario.world.shelf_count}: "
+                f"{run.scenario.source}: world.shelf_count = "
+                f"{run.settings(WorldConfig).shelf_count}: "
                 "expected shelves with a reachable pick station (tasks are served at shelves)"
             )
         self.rng = run.rng.stream("tasks")
@@ -286,11 +288,11 @@ def _reachable_stations(
     run: RunContext, world: Warehouse, static: StaticCostmap, fleet: FleetState
 ) -> np.ndarray:
     """Pick stations where a robot can stand and that the fleet can reach."""
-    radius = run.scenario.robots.radius_m
+    radius = run.settings(RobotsConfig).radius_m
     stations = pick_stations(
         world.shelves,
         radius,
-        run.scenario.tasks.station_offset_m,
+        run.settings(TasksConfig).station_offset_m,
         lambda points: world.is_free(points, radius),
     )
     labels, _ = ndimage.label(static.cost < INSCRIBED, structure=np.ones((3, 3)))

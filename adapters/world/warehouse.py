@@ -5,25 +5,26 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any, ClassVar
 
-from cosim.adapter import RunContext
-from cosim.errors import ScenarioError
-from cosim.hosts import BASE_HOST, HostKind
-from cosim.scenario.model import Scenario
+import numpy as np
+
+from cosim.core.adapter import RunContext, ScenarioView
+from cosim.core.hosts import BASE_HOST, HostKind
+from cosim.core.rng import RngStreams
+from cosim.scenario.fields import model_problem
+from cosim.scenario.sections import RobotsConfig, WorldConfig
 from models.errors import ModelError
 from models.layout import WarehouseSpec
 from models.obstacles import DynamicObstacles
 from models.world import Warehouse, generate_warehouse
 
-
-def warehouse_spec(run: RunContext) -> WarehouseSpec:
-    """The model parameters of the scenario's world and fleet placement."""
-    return spec_from_scenario(run.scenario)
+WORLD_STREAM = "world"
+"""The random stream a scenario's warehouse is generated from."""
 
 
-def spec_from_scenario(scenario: Scenario) -> WarehouseSpec:
+def spec_from_scenario(scenario: ScenarioView) -> WarehouseSpec:
     """The model parameters of a scenario's world and fleet placement (no run needed)."""
-    world = scenario.world
-    robots = scenario.robots
+    world = scenario.section(WorldConfig)
+    robots = scenario.section(RobotsConfig)
     return WarehouseSpec(
         size_m=world.size_m,
         layout=world.layout,
@@ -40,18 +41,25 @@ def spec_from_scenario(scenario: Scenario) -> WarehouseSpec:
     )
 
 
-def build_warehouse(run: RunContext) -> Warehouse:
-    """Generate the scenario's warehouse from the ``world`` random stream.
+def scenario_warehouse(scenario: ScenarioView, rng: np.random.Generator | None = None) -> Warehouse:
+    """The warehouse a run of ``scenario`` builds, also without running anything.
+
+    The run, ``cosim world``, the stand-in launcher and the figures all build it here, from
+    the scenario's ``world`` stream, so each sees the same world.
+
+    Args:
+        scenario: the validated scenario (its seed decides a random layout).
+        rng: the run's ``world`` stream; by default the same stream made from the seed.
 
     Raises:
         ScenarioError: naming the scenario file and the key for impossible requests.
     """
+    if rng is None:
+        rng = RngStreams(scenario.seed).stream(WORLD_STREAM)
     try:
-        return generate_warehouse(warehouse_spec(run), run.rng.stream("world"))
+        return generate_warehouse(spec_from_scenario(scenario), rng)
     except ModelError as error:
-        raise ScenarioError(
-            f"{run.scenario.source}: {error.key} = {error.value!r}: expected {error.expected}"
-        ) from None
+        raise model_problem(scenario.source, error) from None
 
 
 class WorldAdapter:
@@ -61,7 +69,7 @@ class WorldAdapter:
     requires: ClassVar[tuple[str, ...]] = ()
 
     def __init__(self, run: RunContext) -> None:
-        self.warehouse = build_warehouse(run)
+        self.warehouse = scenario_warehouse(run.scenario, run.rng.stream(WORLD_STREAM))
         run.add_host(BASE_HOST, HostKind.BASE)
         run.provide(self.warehouse)
         run.provide(DynamicObstacles())
@@ -72,7 +80,7 @@ class WorldAdapter:
             run.kernel.now_ns,
             "world",
             "built",
-            f"{len(self.warehouse.shelves)} shelves, layout {run.scenario.world.layout}",
+            f"{len(self.warehouse.shelves)} shelves, layout {run.settings(WorldConfig).layout}",
         )
 
     def finish(self, run: RunContext) -> Mapping[str, Any]:

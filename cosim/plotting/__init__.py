@@ -17,7 +17,6 @@ Modules, one concept each:
   :mod:`~cosim.plotting.assignment`: tasks, network and assignment over time;
 - :mod:`~cosim.plotting.rays` and :mod:`~cosim.plotting.animation`: the GIF of a run.
 
-The package imports nothing here on purpose: :mod:`cosim.worldfiles` draws its world
-figure with :mod:`cosim.plotting.world`, and the run figures rebuild worlds with
-:mod:`cosim.worldfiles`, so eager imports would be circular.
+The package imports nothing here on purpose: matplotlib loads only for a figure drawn
+(``cosim world --png``, ``cosim map``, ``cosim plot``), never for a run.
 """

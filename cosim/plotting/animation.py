@@ -18,7 +18,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from PIL import Image
 
-from cosim.errors import ExportError
+from cosim.core.errors import ExportError
 from cosim.plotting.canvas import Color, fleet_colors
 from cosim.plotting.fleet import FleetLayer, fleet_handles
 from cosim.plotting.people import PeopleLayer, people_handles, people_inks

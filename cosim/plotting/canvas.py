@@ -11,7 +11,7 @@ from matplotlib import colormaps
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from cosim.errors import ExportError
+from cosim.core.errors import ExportError
 
 DPI = 150
 """Resolution of PNG figures (dots per inch)."""

@@ -6,7 +6,7 @@ import math
 from collections.abc import Sequence
 from pathlib import Path
 
-from cosim.errors import ExportError
+from cosim.core.errors import ExportError
 from cosim.plotting.animation import animation_gif
 from cosim.plotting.assignment import assignment_figure
 from cosim.plotting.maps import has_maps, maps_figure, quality_figure

@@ -9,10 +9,10 @@ import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
 
-from cosim.errors import ExportError
+from adapters.world.files import read_map
+from cosim.core.errors import ExportError
 from cosim.plotting.canvas import save_png
 from cosim.plotting.rundata import RunData
-from cosim.worldfiles import read_map
 
 PANELS_PER_ROW = 3
 MOST_ROBOTS = 5

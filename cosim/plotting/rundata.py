@@ -15,10 +15,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from cosim.errors import ExportError
+from adapters.world.warehouse import scenario_warehouse
+from cosim.core.errors import ExportError
 from cosim.plotting.canvas import robot_order
 from cosim.scenario import Scenario, load_scenario
-from cosim.worldfiles import scenario_warehouse
 from models.arrays import FloatArray
 from models.world import Warehouse
 

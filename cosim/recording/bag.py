@@ -23,7 +23,7 @@ from rosbags.rosbag2 import StoragePlugin, Writer, WriterError
 from rosbags.rosbag2.enums import CompressionFormat, CompressionMode
 from rosbags.rosbag2.storage_mcap import McapWriter
 
-from cosim.errors import ExportError
+from cosim.core.errors import ExportError
 from cosim.recording.schemas import ChannelSpec, recorded_qos
 
 if sys.version_info >= (3, 14):  # pragma: no cover
@@ -43,8 +43,9 @@ CHUNK_BYTES = 2**20
 
 
 ZSTD_LEVEL = 1
-"""zstd level of MCAP chunks and sqlite3 messages: 1.7x faster than rosbags' default (3) on
-our chunks for the same ratio (6.0 vs 6.1), as rosbag2's ``zstd_fast`` preset chooses speed."""
+"""zstd level of MCAP chunks and sqlite3 messages: faster than rosbags' default (3) for about
+the same ratio on our chunks, as rosbag2's ``zstd_fast`` preset chooses speed
+(``bench/recording_bench.py``)."""
 
 
 def _fast_zstd(data: bytes) -> bytes:

@@ -4,7 +4,7 @@ A channel of a recording is a topic with its ROS 2 type, the type's ``.msg`` def
 with every nested definition appended as rosbag2 embeds it (``ros2msg``), the type's
 RIHS01 hash, and the QoS the topic is offered with. Standard types come from rosbags'
 ROS 2 Humble type store; the project's own (``cosim_msgs``) from
-:mod:`cosim.messages.definitions`, so any tool decodes every recorded message.
+:mod:`cosim.core.messages.definitions`, so any tool decodes every recorded message.
 """
 
 from __future__ import annotations
@@ -24,8 +24,8 @@ from rosbags.interfaces import (
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
 
-from cosim.bus import Advertisement, TopicQos
-from cosim.messages.definitions import DEFINITIONS
+from cosim.core.bus import Advertisement, TopicQos
+from cosim.core.messages.definitions import DEFINITIONS
 
 INFINITE = QosTime(2_147_483_647, 4_294_967_295)
 """An unset deadline, lifespan or lease as Humble's rosbag2 writes it (v8 metadata)."""

@@ -1,8 +1,8 @@
 """The recording tap: bus publications, serialized once, fanned out to the bag and the live view.
 
-It monitors the selected topics on the bus (:meth:`cosim.bus.Bus.monitor`), so a recorded
+It monitors the selected topics on the bus (:meth:`cosim.core.bus.Bus.monitor`), so a recorded
 run delivers, drops and tabulates exactly what an unrecorded one does. Each publication
-is encoded to CDR once (:meth:`cosim.messages.Message.to_cdr`) and handed to every sink
+is encoded to CDR once (:meth:`cosim.core.messages.Message.to_cdr`) and handed to every sink
 with its publication time in simulation nanoseconds, which is also the message's log
 time: stamps in a bag equal the simulation clock.
 """
@@ -12,9 +12,9 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Protocol
 
-from cosim.bus import Bus, Monitor
-from cosim.hosts import HostId
-from cosim.messages import Message
+from cosim.core.bus import Bus, Monitor
+from cosim.core.hosts import HostId
+from cosim.core.messages import Message
 from cosim.recording.schemas import ChannelSpec
 
 

@@ -3,7 +3,7 @@
 Sections of a scenario are frozen dataclasses whose fields are declared with
 :func:`param`. :func:`build` turns a TOML table into such a dataclass, checking every
 key against the annotations and the declared bounds; a problem becomes a
-:class:`~cosim.errors.ConfigError` naming the file, the section, the key, the value and
+:class:`~cosim.core.errors.ConfigError` naming the file, the section, the key, the value and
 what was expected. Unknown keys get a "did you mean" suggestion.
 """
 
@@ -17,7 +17,8 @@ from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from typing import Any, Literal, TypeVar, Union, get_args, get_origin, get_type_hints
 
-from cosim.errors import ConfigError
+from cosim.core.errors import ConfigError, ScenarioError
+from models.errors import ModelError
 
 
 @dataclass(frozen=True, slots=True)
@@ -182,6 +183,21 @@ def format_problem(origin: str, section: str, key: str, value: Any, expected: st
     return f"{origin}: [{section}] {key} = {show_value(value)}: expected {expected}"
 
 
+def model_problem(source: str, error: ModelError, *, value: Any = None) -> ScenarioError:
+    """The one-line error for a model that refuses the scenario's parameters.
+
+    Args:
+        source: the scenario file or preset the parameters came from.
+        error: the model's refusal, naming the parameter as ``section.key``.
+        value: the value to show instead of the model's (when the model was given a
+            value derived from the user's, such as a radius plus a margin).
+    """
+    shown = error.value if value is None else value
+    # a file name is shown whole: its end names the file
+    text = repr(shown) if isinstance(shown, str) and len(shown) <= 4096 else show_value(shown)
+    return ScenarioError(f"{source}: {error.key} = {text}: expected {error.expected}")
+
+
 SHOWN_CHARS = 80
 """Longest value a message shows; longer ones end in an ellipsis."""
 
@@ -343,6 +359,7 @@ __all__ = [
     "docs",
     "field_names",
     "format_problem",
+    "model_problem",
     "param",
     "suggest",
 ]

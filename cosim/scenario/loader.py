@@ -11,7 +11,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from cosim.errors import ConfigError
+from cosim.core.errors import ConfigError
 from cosim.scenario.fields import build, show_name, show_value, suggest
 from cosim.scenario.model import Scenario, section_types
 from cosim.scenario.tomlfile import parse_toml, read_toml_file

@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field, fields, replace
-from typing import Any, get_type_hints
+from typing import Any, TypeVar, get_type_hints
 
+from cosim.core.errors import RegistryError
 from cosim.scenario.humans import HumansConfig
 from cosim.scenario.mapping import MappingConfig
 from cosim.scenario.mixed import MocapConfig, PhysicalConfig
@@ -20,6 +21,8 @@ from cosim.scenario.sections import (
     TasksConfig,
     WorldConfig,
 )
+
+S = TypeVar("S")
 
 
 @dataclass(frozen=True)
@@ -45,6 +48,21 @@ class Scenario:
     humans: HumansConfig = field(default_factory=HumansConfig)
     record: RecordConfig = field(default_factory=RecordConfig)
     source: str = field(default="<defaults>", compare=False)
+
+    def __post_init__(self) -> None:
+        by_type = {type(getattr(self, f.name)): getattr(self, f.name) for f in fields(self)}
+        object.__setattr__(self, "_by_type", by_type)
+
+    def section(self, kind: type[S]) -> S:
+        """The section of type ``kind``.
+
+        Raises:
+            RegistryError: if no section of the scenario has that type.
+        """
+        found = self._by_type.get(kind)  # type: ignore[attr-defined]
+        if found is None:
+            raise RegistryError(f"the scenario has no section of type {kind.__name__}")
+        return found  # type: ignore[no-any-return]
 
     @property
     def seed(self) -> int:

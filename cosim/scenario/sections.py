@@ -173,7 +173,7 @@ class NavigationConfig:
     with scaling 3 (Nav2's code defaults are 0.55 m and 10; the gentler slope keeps robots
     in the middle of 1.6 m aisles). ``stuck`` comes after 30 s without progress: with 50
     robots in one hall, 10 s (Nav2's progress checker) mostly flags robots that are merely
-    slowed by traffic and would arrive (measured: 44 of 214 goals vs 3 of 166 in 120 s).
+    slowed by traffic and would arrive.
     """
 
     planner: Literal["astar"] = param("astar", "global planner on the costmap")

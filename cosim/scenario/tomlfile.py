@@ -12,7 +12,7 @@ import tomllib
 from pathlib import Path
 from typing import Any
 
-from cosim.errors import ConfigError
+from cosim.core.errors import ConfigError
 
 _AT = re.compile(r"\s*\(at line (\d+), column (\d+)\)$")
 SHOWN_CHARS = 60

@@ -12,7 +12,8 @@ import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.ticker import NullLocator
 
-from cosim.analysis import (
+from cosim.core.errors import ConfigError, ExportError
+from cosim.studies.analysis import (
     FIGURES_DIR,
     RESULTS_FILE,
     heatmap,
@@ -22,7 +23,6 @@ from cosim.analysis import (
     standard_figures,
     write_report,
 )
-from cosim.errors import ConfigError, ExportError
 from cosim.studies.spec import StudySpec
 from cosim.studies.timeseries import timeseries_figures
 
@@ -155,8 +155,8 @@ def loglog_figures(
 ) -> tuple[list[Path], list[str]]:
     """Plot each metric against ``x`` on log-log axes to ``figures/<metric>_vs_<x>_loglog.png``.
 
-    Means over seeds with their 95 % bands, as :func:`cosim.analysis.plot_metric` draws them;
-    runs whose ``x`` or metric is not > 0 are left out. A metric no ok run reports is
+    Means over seeds with their 95 % bands, as :func:`cosim.studies.analysis.plot_metric`
+    draws them; runs whose ``x`` or metric is not > 0 are left out. A metric no ok run reports is
     skipped (the report's tables say why).
 
     Returns:
@@ -204,7 +204,7 @@ def loglog_figure(
     hue: str | None = None,
     facet: str | None = None,
 ) -> Figure:
-    """The figure of :func:`cosim.analysis.metric_figure` on log-log axes (values > 0)."""
+    """The figure of :func:`cosim.studies.analysis.metric_figure` on log-log axes (values > 0)."""
     figure = metric_figure(
         results, x, metric, hue=hue, facet=facet, title=f"{metric} vs {x} (log-log)"
     )

@@ -29,7 +29,7 @@ from typing import Protocol, TextIO
 
 import pandas as pd
 
-from cosim.errors import ConfigError, ExportError, WorkerError
+from cosim.core.errors import ConfigError, ExportError, WorkerError
 from cosim.studies.spec import RunSpec, StudySpec
 from cosim.studies.worker import Job, Outcome, failed, run_one
 
@@ -122,7 +122,7 @@ def _local(jobs: list[Job], workers: int) -> Iterator[Outcome]:
     context = get_context("forkserver")
     context.set_forkserver_preload(["cosim.studies.worker", "cosim.studies.warm"])
     # one BLAS thread per worker: the workers already fill the cores, and BLAS thread pools
-    # fighting over them made two workers barely faster than one (measured: 1.25x)
+    # fighting over them made two workers barely faster than one
     for name in BLAS_THREAD_VARIABLES:
         os.environ.setdefault(name, "1")
     with ProcessPoolExecutor(workers, mp_context=context) as pool:

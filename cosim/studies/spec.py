@@ -29,7 +29,7 @@ loglog = ["wall_us_per_robot_s"]  # optional: also drawn on log-log axes (x valu
 ```
 
 Every combination is loaded as a scenario before the study starts, and its adapters check
-the sections they need together (:func:`cosim.assembly.check_scenario`), so a bad key or
+the sections they need together (:func:`cosim.runner.assembly.check_scenario`), so a bad key or
 value, or a combination that cannot run, in any of them is reported (file, key, value,
 expectation) and nothing runs.
 """
@@ -41,10 +41,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from cosim.assembly import adapter_names, check_scenario
-from cosim.errors import ConfigError
-from cosim.registry import AdapterRegistry
-from cosim.runner import execute
+from cosim.core.errors import ConfigError
+from cosim.core.registry import AdapterRegistry
+from cosim.runner.assembly import adapter_names, check_scenario
+from cosim.runner.execute import execute
 from cosim.scenario import load_scenario
 from cosim.scenario.fields import show_name, show_value, suggest
 from cosim.scenario.loader import preset_names
@@ -341,7 +341,7 @@ def _validate_combinations(spec: StudySpec) -> None:
     """Load and check every combination: what it cannot run stops the study here.
 
     A bad key or value, or a combination an adapter refuses
-    (:func:`cosim.assembly.check_scenario`), is reported before any run.
+    (:func:`cosim.runner.assembly.check_scenario`), is reported before any run.
 
     When the study keeps named tables, one scenario per distinct set of adapters is also run
     for a millisecond (adapters create some tables only when they finish), so a table no run

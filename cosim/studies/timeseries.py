@@ -18,8 +18,8 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from scipy import stats as scipy_stats
 
-from cosim.analysis import FIGURES_DIR, load_results
-from cosim.errors import ExportError
+from cosim.core.errors import ExportError
+from cosim.studies.analysis import FIGURES_DIR, load_results
 
 PANELS_PER_ROW = 3
 DPI = 150

@@ -8,7 +8,7 @@ from their cache once, instead of once in every worker.
 from __future__ import annotations
 
 import cosim
-from cosim.runner import execute
+from cosim.runner.execute import execute
 
 _TINY = {
     "scenario.duration_s": 0.5,

@@ -14,8 +14,8 @@ import traceback
 from dataclasses import dataclass
 from typing import Any
 
-from cosim.errors import CosimError
-from cosim.runner import execute
+from cosim.core.errors import CosimError
+from cosim.runner.execute import execute
 from cosim.scenario import load_scenario
 from cosim.scenario.loader import dump_scenario
 

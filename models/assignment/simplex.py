@@ -204,8 +204,8 @@ def ranked(shape: LpShape, columns: Sequence[Column], key: str) -> RankedColumns
 def ranked_rows(shape: LpShape, rows: FloatArray) -> RankedColumns | None:
     """:func:`ranked` of columns given as rows ``(kind, robot, task, cost)`` of one array.
 
-    A basis in its wire form becomes one array in a single call, about 3x faster than
-    reading its :class:`Column` objects one by one (25 against 73 us for 100 columns).
+    A basis in its wire form becomes one array in a single call instead of reading its
+    :class:`Column` objects one by one (``bench/assignment_bench.py`` measures both).
 
     Returns:
         None unless every kind is a :class:`ColumnKind` value, every index a whole number
@@ -233,7 +233,7 @@ def union(shape: LpShape, parts: Sequence[RankedColumns]) -> RankedColumns:
     r, t = shape
     size = 3 * (r + 1) * (t + 1)  # every rank is below this
     if size <= 8 * rank.size + 4096:
-        # marks over all ranks: no sort (a few thousand columns merge in ~50 us, not ~700)
+        # marks over all ranks: linear in the columns, no sort
         present = np.zeros(size, dtype=bool)
         present[rank] = True
         value = np.empty(size)
@@ -376,7 +376,7 @@ def _layout(
 def _layout_arrays(
     r: int, t: int, columns: Sequence[Column]
 ) -> tuple[IntArray, IntArray, IntArray] | None:
-    """:func:`_layout` by whole arrays, 5x faster on a few hundred columns.
+    """:func:`_layout` by whole arrays instead of column by column.
 
     None unless every kind is a :class:`ColumnKind`, every index an integer and every
     column within range: the loop then names the first column out of range.

@@ -324,7 +324,7 @@ def _csr(start: IntArray, count: int, items: int, name: str) -> IntArray:
 
 @lru_cache(maxsize=16)
 def _config(params: DwaParams, limits: DriveLimits) -> FloatArray:
-    """The kernel's flat parameter vector, built once (``astuple`` copies deeply: 16 us a tick).
+    """The kernel's flat parameter vector, built once (``astuple`` copies deeply every call).
 
     Shared between calls: the kernel only reads it.
     """

@@ -12,8 +12,8 @@ entries to pop), the ``f`` and ``g`` of an entry sit side by side, the pop is Fl
 entry rises), and the sifts are written out inline (as numba helper calls they cost a
 third more). Per-cell state lives in one allocation, because several grid-sized
 arrays per call cost more in page faults than a short search, and it is not zeroed: a
-byte per cell says where it is valid (zeroing 13.6 MB on the 1004 x 1004 hall cost
-0.5-0.7 ms a call, over ten times a failed plan from a robot boxed in by its neighbours).
+byte per cell says where it is valid (zeroing the whole hall's state each call would cost
+more than a failed plan of a robot boxed in by its neighbours).
 The heap grows only between expansions, which keeps its arrays fixed inside the hot
 loops.
 """

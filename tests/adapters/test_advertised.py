@@ -3,8 +3,8 @@
 import pytest
 
 import cosim
-from cosim.bus import Bus
-from cosim.runner import execute
+from cosim.core.bus import Bus
+from cosim.runner.execute import execute
 from tests.conftest import SMALL
 
 DRIVERS = [

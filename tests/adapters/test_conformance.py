@@ -6,9 +6,9 @@ import pandas as pd
 import pytest
 
 import cosim
-from cosim.adapter import Adapter
-from cosim.registry import AdapterRegistry
-from cosim.runner import execute
+from cosim.core.adapter import Adapter
+from cosim.core.registry import AdapterRegistry
+from cosim.runner.execute import execute
 
 REGISTRY = AdapterRegistry.from_entry_points()
 SMALL = {
@@ -45,7 +45,14 @@ def test_the_registry_holds_the_core_adapters():
     assert {"world", "fleet", "lidar", "waypoints", "poses"} <= set(REGISTRY.names())
 
 
-@pytest.mark.parametrize("name", REGISTRY.names())
+REAL_TIME = {"physical"}
+"""Adapters whose runs are paced by the wall clock (slow: a run of 5 s takes 5 s, twice)."""
+
+
+@pytest.mark.parametrize(
+    "name",
+    [pytest.param(n, marks=pytest.mark.slow) if n in REAL_TIME else n for n in REGISTRY.names()],
+)
 def test_every_registered_adapter_starts_runs_and_repeats_exactly_with_the_same_seed(name):
     scenario = cosim.load_scenario("warehouse-random", overrides={**SMALL, **NEEDS.get(name, {})})
     first = execute(scenario, names=[name], registry=REGISTRY)
@@ -63,7 +70,7 @@ def test_every_registered_adapter_starts_runs_and_repeats_exactly_with_the_same_
 @pytest.mark.parametrize("name", REGISTRY.names())
 def test_every_registered_adapter_follows_the_adapter_protocol(name):
     scenario = cosim.load_scenario("warehouse-random", overrides={**SMALL, **NEEDS.get(name, {})})
-    from cosim.assembly import assemble
+    from cosim.runner.assembly import assemble
 
     assembly = assemble(scenario, names=[name], registry=REGISTRY)
     built = dict(assembly.adapters)

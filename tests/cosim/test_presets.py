@@ -3,8 +3,14 @@ import pytest
 import cosim
 from cosim.scenario import preset_names
 
+REAL_TIME = {"lab-real-in-virtual", "lab-mixed"}
+"""Presets with a physical robot: their runs are paced by the wall clock."""
 
-@pytest.mark.parametrize("name", preset_names())
+
+@pytest.mark.parametrize(
+    "name",
+    [pytest.param(n, marks=pytest.mark.slow) if n in REAL_TIME else n for n in preset_names()],
+)
 def test_every_preset_runs_two_seconds_without_robots_overlapping(name):
     result = cosim.run(cosim.load_scenario(name), duration_s=2.0)
     assert result.summary["robots"] == cosim.load_scenario(name).robots.count

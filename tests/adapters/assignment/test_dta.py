@@ -9,12 +9,12 @@ import pytest
 
 import cosim
 from adapters.assignment.protocols import SimplexProtocol
-from cosim.adapter import RunContext
-from cosim.assembly import adapter_names
-from cosim.kernel import Stage
-from cosim.registry import AdapterRegistry
-from cosim.runner import execute
-from cosim.timebase import s_to_ns
+from cosim.core.adapter import RunContext
+from cosim.core.kernel import Stage
+from cosim.core.registry import AdapterRegistry
+from cosim.core.timebase import s_to_ns
+from cosim.runner.assembly import adapter_names
+from cosim.runner.execute import execute
 from models.kinematics import FleetState
 from models.obstacles import DynamicObstacles
 
@@ -46,6 +46,7 @@ def _check_exactly_once(result) -> pd.DataFrame:
     return tasks
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("protocol", ["distributed_simplex", "cbba", "greedy", "hungarian"])
 def test_every_task_is_completed_exactly_once_with_each_protocol(protocol):
     result = _run(**{"assignment.protocol": protocol})
@@ -57,6 +58,7 @@ def test_every_task_is_completed_exactly_once_with_each_protocol(protocol):
     assert result.summary["tasks_completed"] == 6
 
 
+@pytest.mark.slow
 def test_the_distributed_simplex_matches_the_centralized_optimum():
     result = _run()
     assert result.summary["epochs_compared"] >= 3
@@ -76,6 +78,7 @@ def test_the_distributed_simplex_matches_the_centralized_optimum():
     assert assignments["converged"].any()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "network",
     [
@@ -93,6 +96,7 @@ def test_lossy_and_bursty_networks_lose_no_task_and_serve_none_twice(protocol, n
     assert result.summary["messages_dropped"] > 0
 
 
+@pytest.mark.slow
 def test_a_partition_that_heals_ends_with_every_task_completed_exactly_once():
     cut = [{"from_s": 2.0, "to_s": 40.0, "hosts": ["base", "robot_1"]}]
     result = _run(**{"network.partitions": cut, "scenario.duration_s": 200.0})
@@ -133,6 +137,7 @@ class Ring:
         return {}
 
 
+@pytest.mark.slow
 def test_a_stuck_robot_gives_its_task_up_and_the_fleet_reassigns_it():
     scenario = cosim.load_scenario(
         "warehouse-random",
@@ -160,6 +165,7 @@ def test_a_stuck_robot_gives_its_task_up_and_the_fleet_reassigns_it():
     assert tasks["t_completed_s"].notna().all()
 
 
+@pytest.mark.slow
 def test_the_same_seed_gives_the_same_tables_for_the_full_loop():
     first = _run(**{"scenario.duration_s": 60.0})
     second = _run(**{"scenario.duration_s": 60.0})
@@ -169,6 +175,7 @@ def test_the_same_seed_gives_the_same_tables_for_the_full_loop():
     assert np.isclose(first.summary["tasks_per_min"], second.summary["tasks_per_min"])
 
 
+@pytest.mark.slow
 def test_convergence_is_timed_from_the_announcement_so_more_latency_never_shortens_it():
     # with aligned timers and both latencies below the 100 ms round period, the robots decide
     # at the same round ticks, so timed from the announcement the convergence times are
@@ -188,6 +195,7 @@ def test_convergence_is_timed_from_the_announcement_so_more_latency_never_shorte
     assert short.summary["mean_convergence_time_s"] > 0.02
 
 
+@pytest.mark.slow
 def test_with_independent_round_timers_latency_below_one_period_still_delays_convergence():
     def convergence(phase: str, latency_ms: float) -> float:
         result = _run(

@@ -1,7 +1,7 @@
 import numpy as np
 
 from adapters.assignment.protocols import BasisDecoder, SimplexProtocol
-from cosim.messages import Message, SimplexBasis
+from cosim.core.messages import Message, SimplexBasis
 from models.assignment.dsimplex import SharedBasis
 from models.assignment.problem import AssignmentProblem, Column, ColumnKind, LpShape
 from models.assignment.simplex import columns_of

@@ -6,12 +6,12 @@ import pytest
 
 import cosim
 from adapters.naming import topic
-from cosim.adapter import RunContext
-from cosim.hosts import HostId
-from cosim.kernel import Stage
-from cosim.messages import Twist
-from cosim.registry import AdapterRegistry
-from cosim.runner import execute
+from cosim.core.adapter import RunContext
+from cosim.core.hosts import HostId
+from cosim.core.kernel import Stage
+from cosim.core.messages import Twist
+from cosim.core.registry import AdapterRegistry
+from cosim.runner.execute import execute
 from models.kinematics import FleetState
 from models.obstacles import DynamicObstacles
 

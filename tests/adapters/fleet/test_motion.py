@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 
 import cosim
-from cosim.registry import AdapterRegistry
-from cosim.runner import execute
+from cosim.core.registry import AdapterRegistry
+from cosim.runner.execute import execute
 
 SMALL = {
     "scenario.duration_s": 6.0,

@@ -30,6 +30,7 @@ def _comparable(frame: pd.DataFrame) -> pd.DataFrame:
     return frame.sort_values("run_id").reset_index(drop=True)
 
 
+@pytest.mark.slow
 def test_a_study_over_worker_counts_gives_the_same_rows_locally_and_on_a_threaded_dask_worker(
     tmp_path,
 ):

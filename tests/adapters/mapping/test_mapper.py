@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import cosim
-from cosim.worldfiles import read_map
+from adapters.world.files import read_map
 from tests.conftest import SMALL
 
 MAPPING = {
@@ -63,6 +63,7 @@ def test_navigation_plans_on_each_robots_own_map_and_localizes_by_its_estimate(m
     assert (navigation.event == "arrived").sum() >= 3
 
 
+@pytest.mark.slow
 def test_sharing_under_total_loss_degrades_to_each_robots_own_map(tmp_path):
     alone = _run(tmp_path / "alone")
     lost = _run(
@@ -89,6 +90,7 @@ def test_shared_evidence_widens_every_robots_map(tmp_path, mode, mapped):
         assert theirs[robot] > mine[robot]
 
 
+@pytest.mark.slow
 def test_the_same_seed_gives_the_same_maps_and_tables(tmp_path):
     first = _run(tmp_path / "a", **{"mapping.share": "maps", "network.profile": "wifi_degraded"})
     second = _run(tmp_path / "b", **{"mapping.share": "maps", "network.profile": "wifi_degraded"})
@@ -98,6 +100,7 @@ def test_the_same_seed_gives_the_same_maps_and_tables(tmp_path):
         assert np.array_equal(first.maps[name].data, second.maps[name].data)
 
 
+@pytest.mark.slow
 def test_robots_can_close_loops_in_a_run(tmp_path):
     closed = _run(tmp_path, **{"mapping.loop_closure": True, "scenario.duration_s": 60.0})
     assert closed.summary["map_loop_closures"] > 0
@@ -111,8 +114,9 @@ def test_loop_closure_with_shared_map_updates_is_refused_naming_the_keys():
         )
 
 
+@pytest.mark.slow
 def test_with_a_robots_layer_the_other_robots_stay_out_of_the_maps():
-    from cosim.worldfiles import scenario_warehouse
+    from adapters.world.warehouse import scenario_warehouse
     from models.mapping.quality import dilate
     from models.occupancy import rasterize_boxes
 

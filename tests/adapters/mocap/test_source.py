@@ -7,10 +7,10 @@ import pytest
 
 import cosim
 from adapters.mocap.intake import PoseIntake
-from cosim.assembly import assemble
-from cosim.errors import BagError, ConfigError
-from cosim.mocap.tracks import read_pose_track
-from cosim.runner import execute
+from adapters.mocap.tracks import read_pose_track
+from cosim.core.errors import BagError, ConfigError
+from cosim.runner.assembly import assemble
+from cosim.runner.execute import execute
 from tests.conftest import SHARED_DATA
 
 NAV2 = SHARED_DATA / "nav2_turtlebot.mcap"
@@ -54,7 +54,7 @@ def test_a_robot_that_gets_no_pose_stops_once_its_last_one_is_too_old():
 
 def run_watching(s: cosim.Scenario, topic: str) -> tuple[list[tuple[int, object]], object]:
     """Run ``s`` and keep every publication on ``topic`` with its time."""
-    from cosim.runner import _run_assembled
+    from cosim.runner.execute import _run_assembled
 
     assembly = assemble(s)
     seen: list[tuple[int, object]] = []

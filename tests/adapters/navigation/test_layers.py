@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from adapters.navigation.layers import StaticLayers, _traversable
-from cosim.messages import OccupancyGrid as GridMessage
+from cosim.core.messages import OccupancyGrid as GridMessage
 from models.navigation.costmap import CostmapParams, StaticCostmap
 from models.occupancy import FREE, OCCUPIED, UNKNOWN, OccupancyGrid, resample
 

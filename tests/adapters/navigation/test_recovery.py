@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from adapters.navigation.recovery import STALL_M, STALL_S, STUCK_KINDS, StallWatch, stuck_kind
-from cosim.timebase import s_to_ns
+from cosim.core.timebase import s_to_ns
 
 TICK_NS = s_to_ns(0.1)
 

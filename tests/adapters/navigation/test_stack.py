@@ -8,13 +8,13 @@ import pytest
 
 import cosim
 from adapters.naming import topic
-from cosim.adapter import RunContext
-from cosim.hosts import HostId
-from cosim.kernel import Stage
-from cosim.messages import Message, NavGoal, NavStatus
-from cosim.registry import AdapterRegistry
-from cosim.runner import execute
-from cosim.timebase import s_to_ns
+from cosim.core.adapter import RunContext
+from cosim.core.hosts import HostId
+from cosim.core.kernel import Stage
+from cosim.core.messages import Message, NavGoal, NavStatus
+from cosim.core.registry import AdapterRegistry
+from cosim.core.timebase import s_to_ns
+from cosim.runner.execute import execute
 from models.kinematics import FleetState
 from models.navigation.costmap import StaticCostmap
 from models.navigation.planner import shortest_path_length_m
@@ -256,6 +256,7 @@ def test_progress_is_reported_while_driving():
     assert np.allclose(np.diff(progress), 1.0)
 
 
+@pytest.mark.slow
 def test_with_one_way_lanes_robots_reach_goals_without_collision_and_repair_their_paths():
     scenario = cosim.load_scenario(
         "fleet50",
@@ -282,7 +283,7 @@ def test_an_unknown_traffic_policy_is_refused_naming_the_key_and_the_choices():
 def test_robots_that_map_drive_on_the_buildings_lanes_laid_into_their_wider_maps():
     from adapters.navigation.layers import lanes_on
     from adapters.navigation.stack import LANE_WIDTH_M
-    from cosim.worldfiles import scenario_warehouse
+    from adapters.world.warehouse import scenario_warehouse
     from models.navigation.costmap import CostmapParams, StaticCostmap
     from models.navigation.lanes import TWO_WAY, aisle_lanes
     from models.occupancy import OCCUPIED, OccupancyGrid, ground_truth_grid

@@ -39,6 +39,7 @@ def _first_plans(result: cosim.RunResult) -> tuple[list[str], list[float]]:
     return list(first["robot"]), list(first["path_length_m"])
 
 
+@pytest.mark.slow
 def test_above_the_size_threshold_every_robot_plans_with_the_same_landmarks(monkeypatch):
     calls = _spy(monkeypatch, 0)
     fleet = {**FLEET, "scenario.duration_s": 20.0}

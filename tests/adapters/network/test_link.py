@@ -10,15 +10,15 @@ import pytest
 import cosim
 from adapters.naming import topic
 from adapters.network.link import NetworkLink
-from cosim.adapter import RunContext
-from cosim.errors import ConfigError
-from cosim.hosts import BASE_HOST, HostId
-from cosim.kernel import Stage
-from cosim.link import AllDelivered, DeliveryStatus, Transfer
-from cosim.messages import Message
-from cosim.registry import AdapterRegistry
-from cosim.rng import RngStreams
-from cosim.runner import execute
+from cosim.core.adapter import RunContext
+from cosim.core.errors import ConfigError
+from cosim.core.hosts import BASE_HOST, HostId
+from cosim.core.kernel import Stage
+from cosim.core.link import AllDelivered, DeliveryStatus, Transfer
+from cosim.core.messages import Message
+from cosim.core.registry import AdapterRegistry
+from cosim.core.rng import RngStreams
+from cosim.runner.execute import execute
 from models.kinematics import FleetState
 from models.network import ConstantLatency, LinkParams, NetworkModel, NoLoss
 from models.network.topology import complete

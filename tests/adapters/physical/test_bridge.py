@@ -11,13 +11,13 @@ from cyclonedds.idl import IdlStruct
 from cyclonedds.idl.annotations import final
 
 import cosim
-from cosim.errors import ConfigError
-from cosim.ros2dds.participant import RosParticipant
-from cosim.ros2dds.qos import QosKind
-from cosim.ros2dds.types import Header, Odometry, Point, Pose, PoseWithCovariance, Quaternion
-from cosim.ros2dds.types import stamp as ros_stamp
-from cosim.runner import execute
-from cosim.standins import Standins
+from adapters.physical.launcher import Standins
+from adapters.ros2dds.participant import RosParticipant
+from adapters.ros2dds.qos import QosKind
+from adapters.ros2dds.types import Header, Odometry, Point, Pose, PoseWithCovariance, Quaternion
+from adapters.ros2dds.types import stamp as ros_stamp
+from cosim.core.errors import ConfigError
+from cosim.runner.execute import execute
 
 pytestmark = pytest.mark.slow
 
@@ -33,6 +33,7 @@ def domain() -> int:
     return random.SystemRandom().randint(1, 200)
 
 
+@pytest.mark.slow
 def test_a_standin_robot_follows_the_navigation_and_stops_when_its_poses_stop():
     s = cosim.load_scenario(
         "lab-real-in-virtual",
@@ -73,6 +74,7 @@ def _odometry(x: float, y: float, *, nan: bool = False) -> Odometry:
     )
 
 
+@pytest.mark.slow
 def test_samples_that_are_not_poses_jumps_and_foreign_writers_are_counted_not_used():
     d = domain()
     s = cosim.load_scenario(

@@ -47,6 +47,7 @@ def _ns(t_s: float) -> int:
     return round(t_s * 1e9)
 
 
+@pytest.mark.slow
 def test_people_markers_sit_where_the_humans_table_has_everyone_at_the_same_stamps(people_run):
     result, types, messages = people_run
     assert types["/humans/markers"] == "visualization_msgs/msg/MarkerArray"

@@ -5,11 +5,11 @@ import numpy as np
 
 import cosim
 from adapters.naming import topic
-from cosim.adapter import RunContext
-from cosim.hosts import HostId
-from cosim.messages import LaserScan
-from cosim.registry import AdapterRegistry
-from cosim.runner import execute
+from cosim.core.adapter import RunContext
+from cosim.core.hosts import HostId
+from cosim.core.messages import LaserScan
+from cosim.core.registry import AdapterRegistry
+from cosim.runner.execute import execute
 from models.obstacles import DynamicObstacles
 
 SCENARIO = {

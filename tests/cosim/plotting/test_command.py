@@ -6,7 +6,7 @@ import pytest
 from PIL import Image
 
 import cosim
-from cosim.errors import ConfigError, ExportError
+from cosim.core.errors import ConfigError, ExportError
 from cosim.plotting.command import plot_run, snapshot_times
 from cosim.plotting.rundata import load_run
 from tests.conftest import SMALL
@@ -26,6 +26,7 @@ def _assert_bounded_pngs(paths: list[Path]) -> None:
             assert max(image.size) < MAX_PNG_SIDE_PX, (path, image.size)
 
 
+@pytest.mark.slow
 def test_a_task_run_gets_every_figure_as_a_bounded_png_in_its_figures_folder(task_run, tmp_path):
     run_dir = Path(shutil.copytree(task_run, tmp_path / "run"))
     written = plot_run(run_dir)
@@ -49,6 +50,7 @@ def test_figures_whose_data_the_run_lacks_are_skipped_not_drawn_empty(waypoint_r
     ]
 
 
+@pytest.mark.slow
 def test_an_old_style_run_folder_without_any_newer_table_still_plots(task_run, copy_of, tmp_path):
     run_dir = copy_of(task_run)
     tables = run_dir / "tables"
@@ -61,12 +63,14 @@ def test_an_old_style_run_folder_without_any_newer_table_still_plots(task_run, c
     _assert_bounded_pngs(written)
 
 
+@pytest.mark.slow
 def test_a_fleet_too_large_for_a_legend_entry_per_robot_plots_bounded_figures(tmp_path):
     overrides = {**SMALL, "robots.count": 12, "world.size_m": [16.0, 16.0]}
     cosim.run(cosim.load_scenario("warehouse-random", overrides=overrides), out=tmp_path / "r")
     _assert_bounded_pngs(plot_run(tmp_path / "r"))
 
 
+@pytest.mark.slow
 def test_the_gif_is_written_with_the_figures_and_listed_last(waypoint_run, tmp_path):
     written = plot_run(waypoint_run, gif=True, out=tmp_path / "figures")
     assert written[-1] == tmp_path / "figures" / "run.gif"

@@ -1,9 +1,12 @@
+import pytest
+
 import cosim
 from cosim.plotting.command import plot_run
 from tests.conftest import SMALL
 from tests.cosim.plotting.conftest import PNG_MAGIC
 
 
+@pytest.mark.slow
 def test_a_mapping_run_gets_its_maps_and_their_quality_drawn(tmp_path):
     overrides = {
         **SMALL,

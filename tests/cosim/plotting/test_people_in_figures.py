@@ -95,6 +95,7 @@ def test_the_run_data_carries_the_humans_table(people_run):
     assert humans["id"].nunique() == 4
 
 
+@pytest.mark.slow
 def test_the_trajectories_figure_shows_everyone_at_their_last_place_and_not_without_them(
     people_run, tmp_path, monkeypatch
 ):
@@ -119,6 +120,7 @@ def test_the_trajectories_figure_shows_everyone_at_their_last_place_and_not_with
     assert _pixels_like(with_png, PERSON_COLOR) > _pixels_like(without_png, PERSON_COLOR)
 
 
+@pytest.mark.slow
 def test_each_snapshot_shows_everyone_where_they_were_at_its_time(
     people_run, tmp_path, monkeypatch
 ):
@@ -143,6 +145,7 @@ def test_each_snapshot_shows_everyone_where_they_were_at_its_time(
     assert checked >= 3
 
 
+@pytest.mark.slow
 def test_the_animation_shows_people_only_in_a_run_with_people(people_run, tmp_path):
     without = replace(people_run, humans=None)
     for run, name in ((people_run, "with.gif"), (without, "without.gif")):

@@ -1,9 +1,9 @@
-"""The facet grid of the study figures (cosim.analysis), which wraps after 3 panels."""
+"""The facet grid of the study figures (cosim.studies.analysis), which wraps after 3 panels."""
 
 import pandas as pd
 import pytest
 
-from cosim.analysis import metric_figure
+from cosim.studies.analysis import metric_figure
 
 X, HUE, FACET = "network.latency_ms", "assignment.protocol", "network.loss_prob"
 

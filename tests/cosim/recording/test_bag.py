@@ -16,12 +16,12 @@ from rosbags.highlevel import AnyReader
 from rosbags.rosbag2 import StoragePlugin, Writer
 
 import cosim
-from cosim.bus import TopicQos
+from cosim.core.bus import TopicQos
+from cosim.core.timebase import NS_PER_S
 from cosim.recording.bag import BagSink, _StreamingWriter
 from cosim.recording.schemas import ChannelSpec, definition, offered_qos
-from cosim.timebase import NS_PER_S
+from tests.bags import TASKS, mcap_file, read_mcap
 from tests.conftest import SMALL
-from tests.cosim.recording.conftest import TASKS, mcap_file, read_mcap
 
 ROBOTS = [f"robot_{i}" for i in (1, 2, 3)]
 
@@ -273,6 +273,7 @@ def test_a_run_killed_mid_way_leaves_a_bag_whose_finished_chunks_read(tmp_path):
     assert "Traceback" not in done.stderr
 
 
+@pytest.mark.slow
 def test_our_bag_and_a_bag_written_by_rosbag2_read_through_one_code_path(task_run, nav2_bag):
     ours = read_mcap(mcap_file(task_run.bag))
     theirs = read_mcap(nav2_bag)

@@ -9,8 +9,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import cosim
-from cosim.cli import main
-from cosim.errors import CosimError
+from cosim.cli.main import main
+from cosim.core.errors import CosimError
 from cosim.scenario.model import section_types
 from cosim.studies import load_study
 
@@ -90,6 +90,7 @@ def _one_line(message: str, *must: str) -> None:
         assert part in message, (part, message)
 
 
+@pytest.mark.slow
 @settings(
     max_examples=300, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
 )

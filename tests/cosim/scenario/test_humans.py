@@ -3,7 +3,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from cosim import load_scenario
-from cosim.errors import ConfigError
+from cosim.core.errors import ConfigError
 
 
 def test_people_are_off_by_default_and_the_preset_has_ten_workers():

@@ -3,7 +3,7 @@ from pathlib import Path
 import pytest
 
 import cosim
-from cosim.errors import ConfigError
+from cosim.core.errors import ConfigError
 from cosim.scenario import dump_scenario, parse_override, preset_names, scenario_from_text
 
 

@@ -6,7 +6,7 @@ from hypothesis import strategies as st
 
 from adapters.mocap.tracking import external_bodies, physical_robots, tracked_robots
 from cosim import load_scenario
-from cosim.errors import ConfigError
+from cosim.core.errors import ConfigError
 
 NAMES = ["robot_1", "robot_2", "robot_3"]
 
@@ -120,6 +120,7 @@ KEYS = [
 ]
 
 
+@pytest.mark.slow
 @settings(max_examples=300, deadline=None)
 @given(st.dictionaries(st.sampled_from(KEYS), VALUES, max_size=4))
 def test_any_mocap_or_physical_values_load_or_fail_with_a_config_error(overrides):
@@ -136,7 +137,7 @@ def test_any_mocap_or_physical_values_load_or_fail_with_a_config_error(overrides
 
 
 def test_a_series_goal_outside_the_room_is_named_before_the_run():
-    from cosim.assembly import assemble
+    from cosim.runner.assembly import assemble
 
     s = load_scenario("lab-real-in-virtual", {"navigation.goals": [[1.0, 1.0], [5.0, 2.0]]})
     with pytest.raises(ConfigError, match=r"goals has \[5, 2\]: expected points inside"):

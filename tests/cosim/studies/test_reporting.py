@@ -8,7 +8,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from cosim.errors import ConfigError
+from cosim.core.errors import ConfigError
 from cosim.studies import load_study, run_study
 from cosim.studies.reporting import (
     DERIVED_METRICS,

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from cosim.errors import ConfigError
+from cosim.core.errors import ConfigError
 from cosim.studies import load_study
 
 BASE = """
@@ -100,6 +100,7 @@ def test_a_loglog_x_of_zero_in_a_case_names_the_case(tmp_path):
         load_study(path)
 
 
+@pytest.mark.slow
 def test_the_command_line_exits_2_with_one_line_on_a_bad_loglog(tmp_path):
     path = _study(tmp_path, 'x = "robots.count"\nloglog = "wall_time_s"\n')
     done = subprocess.run(

@@ -4,7 +4,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import cosim
-from cosim.worldfiles import scenario_warehouse
+from adapters.world.warehouse import scenario_warehouse
 from models.errors import ModelError
 from models.humans.aisles import SAMPLE_M, aisle_graph, dock_points, pick_stations
 from models.layout import WarehouseSpec

@@ -193,6 +193,7 @@ def _search_by_translation_py(
 _search_by_translation = numba.njit(_search_by_translation_py)
 
 
+@pytest.mark.slow
 @settings(max_examples=25, deadline=None)
 @given(
     x=st.floats(-1.5, 13.5), y=st.floats(-1.5, 9.5), yaw=st.floats(-3.1, 3.1),

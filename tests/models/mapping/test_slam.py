@@ -1,6 +1,7 @@
 import math
 
 import numpy as np
+import pytest
 
 from models.mapping.grid import LogOddsMap, MapGeometry
 from models.mapping.loops import LoopParams
@@ -71,6 +72,7 @@ def test_the_correction_maps_odometry_onto_the_estimate():
     assert np.allclose(compose(mapper.correction, inverse(mapper.correction)), (0, 0, 0))
 
 
+@pytest.mark.slow
 def test_loop_closure_keeps_the_way_back_on_the_way_out():
     errors, _, mapper = _drive(0.01, matching=True, loops=True)
     assert mapper.loops is not None and mapper.loops.closures > 0

@@ -1,0 +1,319 @@
+"""The humans adapter: workers and forklifts from SUMO, stepped in lockstep with the kernel.
+
+At construction it builds the aisle graph of the warehouse, draws the demand from the
+``humans/demand`` stream, writes SUMO's files (network through netconvert, demand,
+config) and keeps them for the run folder's ``sumo/``.
+
+**Synchronization.** Every ``humans.step_length_s`` (Δ) at instant t_k = kΔ, in the
+``EXTERNAL`` stage (after the robots' physics step of that instant, before any sensor):
+
+1. the robots' mirrors in SUMO are placed at the robots' true poses at t_k;
+2. SUMO advances from t_(k-1) to t_k (its clock equals the kernel's after every step;
+   people appear from t_1 = Δ on), its people reacting to the mirrors as placed;
+3. people and forklifts at t_k become the run's dynamic obstacles, seen by every lidar
+   and collision check until t_(k+1) (sample and hold). A person SUMO put reaching into a
+   shelf (its lane runs along the shelf's face) is first moved out until it touches it
+   (``humans_pushed_out`` counts these samples);
+4. a walker with a robot in the way stops in SUMO until the way is clear, for at most
+   ``humans.yield_s`` (:mod:`models.humans.yielding`; ``humans_yields`` counts them):
+   SUMO's own pedestrians only give way to a vehicle ahead on their lane.
+
+There is no lookahead: SUMO never runs ahead of the kernel. People react to robots with
+a delay of up to one step; between steps cosim holds a person where SUMO put them at
+t_k, so the true position differs from the held one by at most v·Δ (0.12 m for a worker
+at 1.2 m/s and Δ = 0.1 s, 0.22 m for a forklift at 2.2 m/s). Lidar ranges and
+clearances to people carry that error.
+"""
+
+from __future__ import annotations
+
+import shutil
+import tempfile
+import time
+import weakref
+from collections.abc import Mapping
+from dataclasses import replace
+from pathlib import Path
+from typing import Any, ClassVar, Literal
+
+import numpy as np
+
+from adapters.humans.files import (
+    TrafficTypes,
+    write_config,
+    write_demand,
+    write_network,
+)
+from adapters.humans.session import Movers, SumoSession
+from adapters.humans.tables import HumanRecords
+from cosim.core.adapter import RunContext
+from cosim.core.kernel import Stage
+from cosim.core.timebase import NS_PER_S, period_ns, s_to_ns
+from cosim.scenario.fields import model_problem
+from cosim.scenario.humans import HumansConfig
+from cosim.scenario.sections import RobotsConfig, ScenarioSection
+from models.arrays import FloatArray
+from models.errors import ModelError
+from models.humans.aisles import AisleGraph, IntArray, aisle_graph, dock_points, pick_stations
+from models.humans.bodies import push_out, two_disc_cover, vehicle_centres
+from models.humans.demand import Plan, plans, standing_plans
+from models.humans.yielding import Yielding, robots_ahead
+from models.kinematics import FleetState
+from models.obstacles import DynamicObstacles
+from models.world import Warehouse
+
+CLEARANCE_MARGIN_M = 0.1
+"""Aisle lines keep a worker's radius plus this from shelves and walls (m)."""
+
+
+class People:
+    """The people and forklifts now, for other adapters (markers, figures).
+
+    Attributes:
+        names: their ids.
+        kinds: ``person`` or ``forklift`` per id.
+        x_m, y_m, yaw_rad, speed_mps: their poses and speeds (``map``).
+        discs, disc_names: the (k, 3) discs ``x_m, y_m, radius_m`` that lidars and collision
+            checks see (two per forklift), and whose each disc is.
+    """
+
+    def __init__(self) -> None:
+        self.names: list[str] = []
+        self.kinds: list[str] = []
+        self.x_m = np.zeros(0)
+        self.y_m = np.zeros(0)
+        self.yaw_rad = np.zeros(0)
+        self.speed_mps = np.zeros(0)
+        self.discs = np.zeros((0, 3))
+        self.disc_names: list[str] = []
+        self.forklift_size_m = (0.0, 0.0)
+        self.worker_radius_m = 0.0
+
+
+class HumansAdapter:
+    """People and forklifts in the aisles, co-simulated with SUMO through libsumo."""
+
+    name: ClassVar[str] = "humans"
+    requires: ClassVar[tuple[str, ...]] = ("world", "fleet")
+
+    def __init__(self, run: RunContext) -> None:
+        cfg = run.settings(HumansConfig)
+        self.cfg = cfg
+        world = run.service(Warehouse)
+        self.fleet = run.service(FleetState)
+        self.dynamic = run.service(DynamicObstacles)
+        self.graph, stations, docks = _graph(run, world)
+        demand = _demand(run, self.graph, stations, docks)
+        limits = run.settings(RobotsConfig)
+        duration_s = run.settings(ScenarioSection).duration_s
+        self.folder = Path(tempfile.mkdtemp(prefix="cosim-sumo-"))
+        # removed by close(); also when a run is assembled but never started (cosim check)
+        weakref.finalize(self, shutil.rmtree, self.folder, True)
+        self.step_ns = period_ns(1.0 / cfg.step_length_s)
+        self.seed = int(run.rng.stream("humans/sumo").integers(1, 2**31 - 1))
+        try:
+            lanes = write_network(
+                self.graph,
+                self.folder,
+                forklifts=cfg.forklifts > 0,
+                inset_m=2 * cfg.worker_radius_m,
+            )
+            types = TrafficTypes(
+                worker_width_m=2 * cfg.worker_radius_m,
+                worker_speed_mps=cfg.worker_speed_mps,
+                robot_size_m=2 * limits.radius_m,
+                robot_speed_mps=limits.max_speed_mps,
+                forklift_length_m=cfg.forklift_size_m[0],
+                forklift_width_m=cfg.forklift_size_m[1],
+                forklift_speed_mps=cfg.forklift_speed_mps,
+            )
+            write_demand(self.graph, demand, lanes, types, self.folder)
+            self.config = write_config(
+                self.folder,
+                step_s=self.step_ns / NS_PER_S,
+                seed=self.seed,
+                end_s=duration_s + 1.0,
+                # a stripe per person's width: two people pass each other in a 1.1 m lane
+                stripe_width_m=2 * cfg.worker_radius_m,
+                jam_time_s=cfg.jam_time_s,
+            )
+        except BaseException:
+            shutil.rmtree(self.folder, ignore_errors=True)
+            raise
+        self.people = People()
+        self.people.forklift_size_m = cfg.forklift_size_m
+        self.people.worker_radius_m = cfg.worker_radius_m
+        run.provide(self.people)
+        self.records = HumanRecords(run, cfg)
+        self.recorder = run.recorder
+        self.session: SumoSession | None = None
+        self.steps = 0
+        self.coupling_s = 0.0
+        self.yielding = Yielding(s_to_ns(cfg.yield_s))
+        self.boxes = world.boxes
+        self.pushed = 0
+        """Person samples SUMO put reaching into a shelf or wall, moved out (see push_out)."""
+
+    def start(self, run: RunContext) -> None:
+        """Start SUMO, mirror the robots into it and step it every ``step_length_s``."""
+        self.session = SumoSession(self.config, seed=self.seed)
+        self.session.add_robots(self.fleet.names, "e0")
+        # SUMO starts at 0 with nobody inserted yet; its first step brings it to Δ
+        run.kernel.every(
+            self.step_ns,
+            lambda now: self._step(run, now),
+            stage=Stage.EXTERNAL,
+            start_ns=self.step_ns,
+        )
+
+    def _step(self, run: RunContext, now_ns: int) -> None:
+        assert self.session is not None
+        began = time.perf_counter()
+        fleet = self.fleet
+        session = self.session
+        session.move_robots(fleet.x, fleet.y, fleet.yaw)
+        session.step(now_ns / NS_PER_S)
+        walkers = session.people()
+        drivers = session.vehicles() if self.cfg.forklifts else None
+        self._publish(walkers, drivers)
+        if self.cfg.yield_s > 0:
+            self._give_way(now_ns, session)
+        self.steps += 1
+        self.coupling_s += time.perf_counter() - began
+        self.records.sample(now_ns, self.people)
+
+    def _publish(self, walkers: Movers, drivers: Movers | None) -> None:
+        cfg = self.cfg
+        people = self.people
+        xy, pushed = push_out(
+            np.column_stack([walkers.x_m, walkers.y_m]), cfg.worker_radius_m, self.boxes
+        )
+        self.pushed += pushed
+        walkers = replace(walkers, x_m=xy[:, 0], y_m=xy[:, 1])
+        discs = [np.column_stack([xy, np.full(len(walkers.names), cfg.worker_radius_m)])]
+        names = list(walkers.names)
+        kinds = ["person"] * len(names)
+        x, y, yaw, speed = [walkers.x_m], [walkers.y_m], [walkers.yaw_rad], [walkers.speed_mps]
+        if drivers is not None and drivers.names:
+            length, width = cfg.forklift_size_m
+            cx, cy = vehicle_centres(drivers.x_m, drivers.y_m, drivers.yaw_rad, length)
+            discs.append(two_disc_cover(cx, cy, drivers.yaw_rad, length, width))
+            names += list(drivers.names) * 2
+            kinds += ["forklift"] * (2 * len(drivers.names))
+            x.append(cx)
+            y.append(cy)
+            yaw.append(drivers.yaw_rad)
+            speed.append(drivers.speed_mps)
+        people.discs = np.vstack(discs)
+        people.disc_names = names
+        self.dynamic.update("humans", people.discs, names, kinds)
+        people.names = list(walkers.names) + (list(drivers.names) if drivers is not None else [])
+        people.kinds = ["person"] * len(walkers.names) + ["forklift"] * (
+            len(people.names) - len(walkers.names)
+        )
+        people.x_m = np.concatenate(x)
+        people.y_m = np.concatenate(y)
+        people.yaw_rad = np.concatenate(yaw)
+        people.speed_mps = np.concatenate(speed)
+
+    def _give_way(self, now_ns: int, session: SumoSession) -> None:
+        """Stop walkers with a robot in their way; let them go when clear or tired of it."""
+        people = self.people
+        walkers = [k for k, kind in enumerate(people.kinds) if kind == "person"]
+        fleet = self.fleet
+        discs = np.column_stack(
+            [
+                people.x_m[walkers],
+                people.y_m[walkers],
+                np.full(len(walkers), self.cfg.worker_radius_m),
+            ]
+        )
+        blocked = robots_ahead(
+            discs,
+            people.yaw_rad[walkers],
+            self.cfg.worker_speed_mps,
+            np.column_stack([fleet.x, fleet.y, fleet.radius_m]),
+        )
+        names = [people.names[k] for k in walkers]
+        walking = people.speed_mps[walkers] > 0.0
+        stop, go = self.yielding.update(now_ns, names, blocked, walking)
+        if go:
+            session.release(go)
+        if stop:
+            session.hold(stop)
+
+    def close(self) -> None:
+        """Stop SUMO and keep its files (and log) for the run folder's ``sumo/``."""
+        if self.session is not None:
+            self.session.close()
+        if self.folder.is_dir():
+            for path in sorted(self.folder.iterdir()):
+                if path.suffix in (".xml", ".sumocfg", ".log") and path.stat().st_size > 0:
+                    self.recorder.add_file(f"sumo/{path.name}", path.read_bytes())
+            shutil.rmtree(self.folder, ignore_errors=True)
+
+    def finish(self, run: RunContext) -> Mapping[str, Any]:
+        """People metrics and the coupling's cost."""
+        summary = self.records.summary(run)
+        summary.update(
+            {
+                "humans_workers": self.cfg.workers,
+                "humans_standing": len(self.cfg.standing),
+                "humans_forklifts": self.cfg.forklifts,
+                "humans_sumo_steps": self.steps,
+                "humans_pushed_out": self.pushed,
+                "humans_yields": self.yielding.yields,
+                "humans_coupling_wall_s": round(self.coupling_s, 4),
+                "humans_sumo_in_process": bool(self.session and self.session.in_process),
+            }
+        )
+        return summary
+
+
+Spots = tuple[IntArray, FloatArray]
+"""Places on the aisle graph: edge indices and offsets along them (m)."""
+
+
+def _demand(run: RunContext, graph: AisleGraph, stations: Spots, docks: Spots) -> list[Plan]:
+    """Every worker's, forklift's and standing worker's plan, from ``humans/demand``."""
+    cfg = run.settings(HumansConfig)
+    rng = run.rng.stream("humans/demand")
+    duration_s = run.settings(ScenarioSection).duration_s
+    demand: list[Plan] = []
+    movers: tuple[tuple[Literal["worker", "forklift"], int, float], ...] = (
+        ("worker", cfg.workers, cfg.worker_speed_mps),
+        ("forklift", cfg.forklifts, cfg.forklift_speed_mps),
+    )
+    for kind, count, speed in movers:
+        demand += plans(
+            graph,
+            stations,
+            docks,
+            kind=kind,
+            count=count,
+            duration_s=duration_s,
+            speed_mps=speed,
+            stay_s=cfg.pick_s,
+            rng=rng,
+        )
+    standing = np.array(cfg.standing, dtype=float).reshape(-1, 2)
+    try:
+        return demand + standing_plans(graph, standing, duration_s)
+    except ModelError as error:
+        raise model_problem(run.scenario.source, error) from None
+
+
+def _graph(run: RunContext, world: Warehouse) -> tuple[AisleGraph, Spots, Spots]:
+    cfg = run.settings(HumansConfig)
+    try:
+        graph = aisle_graph(
+            world,
+            clearance_m=cfg.worker_radius_m + CLEARANCE_MARGIN_M,
+            spacing_m=cfg.aisle_spacing_m,
+        )
+        stations = pick_stations(world, graph, cfg.stations, run.rng.stream("humans/stations"))
+    except ModelError as error:
+        # the graph is asked for the radius plus a margin: name what the user wrote
+        value = cfg.worker_radius_m if error.key == "humans.worker_radius_m" else None
+        raise model_problem(run.scenario.source, error, value=value) from None
+    return graph, stations, dock_points(graph)

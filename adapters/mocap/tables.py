@@ -1,0 +1,67 @@
+"""Motion-capture records: ``tables/mocap`` rows and the summary counts.
+
+Rows are the exceptions, not the stream: rejected poses (a jump beyond what the robot can
+drive, a stamp out of order, a sample that is not a pose) and the robots stopped because
+their newest pose was too old, and when they got a fresh one again.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from typing import Any
+
+from cosim.core.adapter import RunContext
+from cosim.core.recorder import Table
+from cosim.core.timebase import NS_PER_S
+
+MOCAP_COLUMNS = ("t_s", "robot", "event", "detail")
+
+EVENTS = ("jump", "out_of_order", "invalid", "stale", "fresh")
+"""The events of ``tables/mocap``."""
+
+
+class MocapRecords:
+    """The ``mocap`` table and counters, shared by the pose source and the robots' software.
+
+    Get it with :meth:`of`, whichever adapter asks first creates it.
+    """
+
+    def __init__(self, run: RunContext) -> None:
+        self.table: Table = run.recorder.table(
+            "mocap", MOCAP_COLUMNS, categorical=("robot", "event")
+        )
+        self.counts: Counter[str] = Counter()
+        self._reported = False
+
+    @classmethod
+    def of(cls, run: RunContext) -> MocapRecords:
+        """The run's records, created on first use."""
+        if not run.has_service(cls):
+            run.provide(cls(run))
+        return run.service(cls)
+
+    def row(self, t_ns: int, robot: str, event: str, detail: str = "") -> None:
+        """Record one event (one of :data:`EVENTS`)."""
+        if event not in EVENTS:
+            raise ValueError(f"unknown mocap event {event!r}; expected one of {EVENTS}")
+        self.table.append(t_s=t_ns / NS_PER_S, robot=robot, event=event, detail=detail)
+        self.counts[event] += 1
+
+    def count(self, key: str, n: int = 1) -> None:
+        """Count something that gets no row (poses published, dropouts)."""
+        self.counts[key] += n
+
+    def summary(self) -> dict[str, Any]:
+        """``mocap_*`` summary keys; only to the first adapter that asks (they are shared)."""
+        if self._reported:
+            return {}
+        self._reported = True
+        c = self.counts
+        return {
+            "mocap_poses": c["poses"],
+            "mocap_dropouts": c["dropouts"],
+            "mocap_rejected_jumps": c["jump"],
+            "mocap_rejected_out_of_order": c["out_of_order"],
+            "mocap_invalid": c["invalid"],
+            "mocap_stale_stops": c["stale"],
+        }

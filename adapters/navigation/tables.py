@@ -1,0 +1,116 @@
+"""Navigation records: ``tables/navigation`` rows and the navigation summary.
+
+``plan_ms`` is the wall-clock time of a plan, a column that is not a function of the
+scenario and seed; it is registered as volatile, and runs are compared without it
+(:meth:`cosim.runner.execute.RunResult.deterministic_tables`).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from adapters.navigation.recovery import STUCK_KINDS
+from cosim.core.recorder import Recorder
+from cosim.core.timebase import NS_PER_S
+
+NAV_COLUMNS = (
+    "t_s",
+    "robot",
+    "event",
+    "goal_x_m",
+    "goal_y_m",
+    "path_length_m",
+    "plan_ms",
+    "detail",
+)
+
+
+class NavRecords:
+    """Rows of ``tables/navigation`` and the statistics behind the summary.
+
+    Args:
+        recorder: the run's recorder.
+        names: robot names, by index.
+    """
+
+    def __init__(self, recorder: Recorder, names: list[str]) -> None:
+        self.table = recorder.table(
+            "navigation",
+            NAV_COLUMNS,
+            categorical=("robot", "event", "detail"),
+            volatile=("plan_ms",),
+        )
+        self.recorder = recorder
+        self.names = names
+        n = len(names)
+        self.goal_t0_ns = np.zeros(n, dtype=np.int64)
+        self.goal_d0_m = np.zeros(n)
+        self.shortest_m = np.full(n, math.nan)
+        self.times_s: list[float] = []
+        self.ratios: list[float] = []
+        self.counts: dict[str, int] = {}
+        self.stuck_kinds: dict[str, int] = {}
+
+    def row(
+        self,
+        t_ns: int,
+        i: int,
+        event: str,
+        goal_x_m: float,
+        goal_y_m: float,
+        *,
+        path_length_m: float = math.nan,
+        plan_ms: float = math.nan,
+        detail: str = "",
+    ) -> None:
+        """Record one navigation event of robot ``i``."""
+        self.table.append(
+            t_s=t_ns / NS_PER_S,
+            robot=self.names[i],
+            event=event,
+            goal_x_m=float(goal_x_m),
+            goal_y_m=float(goal_y_m),
+            path_length_m=float(path_length_m),
+            plan_ms=float(plan_ms),
+            detail=detail,
+        )
+        self.counts[event] = self.counts.get(event, 0) + 1
+        if event in ("stuck", "unreachable", "arrived"):
+            text = f"goal ({goal_x_m:.2f}, {goal_y_m:.2f})" + (f": {detail}" if detail else "")
+            self.recorder.event(t_ns, self.names[i], event, text)
+
+    def stuck(self, kind: str) -> None:
+        """Count a ``stuck`` report by its kind, one of :data:`STUCK_KINDS`."""
+        self.stuck_kinds[kind] = self.stuck_kinds.get(kind, 0) + 1
+
+    def start_goal(self, i: int, t_ns: int, driven_m: float, shortest_m: float) -> None:
+        """Remember when and where a goal started (for time to goal and path ratio)."""
+        self.goal_t0_ns[i] = t_ns
+        self.goal_d0_m[i] = driven_m
+        self.shortest_m[i] = shortest_m
+
+    def arrived(self, t_ns: int, i: int, goal_x_m: float, goal_y_m: float, driven_m: float) -> None:
+        """Record an arrival and its time and path-length ratio."""
+        self.row(t_ns, i, "arrived", goal_x_m, goal_y_m, path_length_m=driven_m - self.goal_d0_m[i])
+        self.times_s.append((t_ns - int(self.goal_t0_ns[i])) / NS_PER_S)
+        shortest = self.shortest_m[i]
+        if shortest > 0.5:  # goals next to the robot say nothing about path quality
+            self.ratios.append((driven_m - self.goal_d0_m[i]) / shortest)
+
+    def summary(self, sim_time_s: float) -> dict[str, Any]:
+        """Navigation metrics for ``summary.json``."""
+        counts = self.counts
+        return {
+            "goals": counts.get("goal", 0),
+            "arrivals": counts.get("arrived", 0),
+            "mean_time_to_goal_s": round(float(np.mean(self.times_s)), 6) if self.times_s else None,
+            "path_length_ratio": round(float(np.mean(self.ratios)), 6) if self.ratios else None,
+            "deadlocks": counts.get("stuck", 0),
+            **{f"stuck_{kind}": self.stuck_kinds.get(kind, 0) for kind in STUCK_KINDS},
+            "goals_unreachable": counts.get("unreachable", 0),
+            "replans": counts.get("replan", 0),
+            "recoveries": counts.get("recovery", 0),
+        }

@@ -1,0 +1,1 @@
+"""The ``cosim`` command line: argument parsing, the commands and the progress line."""

@@ -1,0 +1,334 @@
+"""The ``cosim`` command line's arguments: every subcommand, its flags and their checks.
+
+A flag's value is checked as it is parsed; a bad one is one line and exit status 2
+(``cosim run --live-port 70000``: "70000 is not a TCP port").
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import NoReturn
+
+from adapters.physical.standin import add_arguments as add_standin_arguments
+
+EXIT_INPUT = 2
+
+
+class Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line and exit 2."""
+
+    def error(self, message: str) -> NoReturn:
+        """Print one line naming the problem and exit 2."""
+        self.exit(EXIT_INPUT, f"{self.prog}: error: {message} (see `{self.prog} --help`)\n")
+
+
+def _non_negative_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"{value} is negative; expected an integer >= 0")
+    return value
+
+
+def _non_negative_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not value >= 0 or value == float("inf"):
+        raise argparse.ArgumentTypeError(f"{text} is not a finite number >= 0")
+    return value
+
+
+def _positive_int(text: str) -> int:
+    value = _non_negative_int(text)
+    if value == 0:
+        raise argparse.ArgumentTypeError("0 is not an integer >= 1")
+    return value
+
+
+def _positive_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not value > 0 or value == float("inf"):
+        raise argparse.ArgumentTypeError(f"{text} is not a finite number > 0")
+    return value
+
+
+def _port(text: str) -> int:
+    value = _non_negative_int(text)
+    if value > 65535:
+        raise argparse.ArgumentTypeError(f"{value} is not a TCP port (expected 0 to 65535)")
+    return value
+
+
+def _times(text: str) -> list[float]:
+    values = []
+    for part in text.split(","):
+        try:
+            value = float(part)
+        except ValueError:
+            raise argparse.ArgumentTypeError(
+                f"{part.strip()!r} in {text!r} is not a number; expected times in s, "
+                "comma-separated (e.g. 10,20,30)"
+            ) from None
+        if not value >= 0 or value == float("inf"):
+            raise argparse.ArgumentTypeError(f"{part.strip()} is not a finite time >= 0 (s)")
+        values.append(value)
+    return values
+
+
+def _scenario_argument(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "scenario",
+        metavar="SCENARIO",
+        help="a scenario TOML file, or a preset name (list them with `cosim scenarios`)",
+    )
+    parser.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="SECTION.KEY=VALUE",
+        help="override one scenario key, e.g. --set lidar.rate_hz=20 (repeatable; values are TOML)",
+    )
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of every subcommand."""
+    parser = Parser(
+        prog="cosim",
+        description=(
+            "Deterministic discrete-event co-simulation of autonomous mobile robot fleets: "
+            "kinematics, lidar and the network between robots, recorded as tables."
+        ),
+        epilog="Exit status: 0 done, 2 invalid input, 1 internal error.",
+    )
+    commands = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
+    commands.required = True
+
+    run = commands.add_parser(
+        "run",
+        help="run a scenario and write its results folder",
+        description=(
+            "Run a scenario to its duration and write summary.json, scenario.toml (the fully "
+            "resolved scenario), tables/*.parquet and a ROS 2 bag (bag/, written while the "
+            "run goes) into the output folder."
+        ),
+    )
+    _scenario_argument(run)
+    run.add_argument(
+        "--standin",
+        action="store_true",
+        help="start a stand-in robot process (cosim standin) for every physical robot of "
+        "the scenario, so mixed-reality scenarios run without hardware",
+    )
+    run.add_argument("--out", type=Path, help="results folder (default: runs/NAME-seedN)")
+    run.add_argument("--seed", type=_non_negative_int, help="override scenario.seed")
+    run.add_argument("--duration-s", type=_positive_float, help="override scenario.duration_s (s)")
+    run.add_argument("--force", action="store_true", help="replace results in a non-empty --out")
+    run.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    run.add_argument(
+        "--bag",
+        choices=("mcap", "sqlite3", "none"),
+        help="ROS 2 bag in OUT/bag: mcap (default; Foxglove, ros2 bag), sqlite3 (.db3) or "
+        "none (same as --set record.bag=...; topics from record.topics)",
+    )
+    run.add_argument(
+        "--figures", action="store_true", help="draw the run's figures into OUT/figures at the end"
+    )
+    run.add_argument(
+        "--gif", action="store_true", help="also write an animation OUT/figures/run.gif"
+    )
+    live = run.add_argument_group(
+        "live view",
+        "Serve the run over the Foxglove WebSocket protocol while it goes, paced against the "
+        "wall clock: in Foxglove, Open connection > Foxglove WebSocket > ws://HOST:PORT.",
+    )
+    live.add_argument("--live", action="store_true", help="serve the run live to Foxglove")
+    live.add_argument(
+        "--live-port", type=_port, default=8765, help="TCP port of the live view (default 8765)"
+    )
+    live.add_argument(
+        "--live-host",
+        default="127.0.0.1",
+        help="address to bind (default 127.0.0.1: this machine only; 0.0.0.0: every interface)",
+    )
+    live.add_argument(
+        "--live-rate",
+        type=_positive_float,
+        default=1.0,
+        help="simulated seconds per wall-clock second (default 1.0: real time)",
+    )
+    live.add_argument(
+        "--live-wait",
+        action="store_true",
+        help="start the run only once a viewer has subscribed to a topic",
+    )
+
+    check = commands.add_parser(
+        "check",
+        help="validate a scenario without running it",
+        description=(
+            "Load and validate a scenario, build its world and adapters without running "
+            "them, and print a one-line description."
+        ),
+    )
+    _scenario_argument(check)
+    check.add_argument("--print", action="store_true", help="print the fully resolved scenario")
+
+    world = commands.add_parser(
+        "world",
+        help="write a scenario's world as a picture, a ROS map and a Gazebo world",
+        description=(
+            "Build the scenario's world (the same one `cosim run` builds for that seed) and "
+            "write it as a PNG picture, a ROS map_server map (PGM + YAML, loadable by "
+            "nav2_map_server) and/or a Gazebo SDF world. Without an output flag, print a "
+            "description of the world."
+        ),
+    )
+    _scenario_argument(world)
+    world.add_argument("--seed", type=_non_negative_int, help="override scenario.seed")
+    world.add_argument("--png", type=Path, metavar="F.png", help="write a picture of the world")
+    world.add_argument("--map", type=Path, metavar="F.yaml", help="write a map_server map")
+    world.add_argument("--sdf", type=Path, metavar="F.sdf", help="write a Gazebo SDF world")
+    world.add_argument(
+        "--resolution-m", type=_positive_float, default=0.05, help="map resolution (m/cell)"
+    )
+
+    study = commands.add_parser(
+        "study",
+        help="run a study: a scenario swept over overrides and seeds",
+        description=(
+            "Run every combination of a study file's [grid] (and [[cases]]) for every seed, on "
+            "local processes or a Dask cluster, and write DIR/results.parquet (one row per run), "
+            "DIR/runs/<run_id>/, and figures and report.md when the study has a [report]."
+        ),
+    )
+    study.add_argument("study", metavar="STUDY.toml", type=Path, help="the study file")
+    study.add_argument("--out", type=Path, help="study folder (default: runs/studies/NAME)")
+    study.add_argument("--workers", type=_positive_int, help="local processes (default: cores)")
+    study.add_argument(
+        "--scheduler",
+        metavar="tcp://HOST:PORT",
+        help="run on this Dask scheduler instead of local processes",
+    )
+    study.add_argument(
+        "--resume",
+        action="store_true",
+        help="continue a study in --out: skip finished runs, retry failed ones",
+    )
+    study.add_argument(
+        "--quiet", action="store_true", help="no progress bar (the summary lines remain)"
+    )
+
+    bag = commands.add_parser(
+        "bag",
+        help="look into ROS 2 bags (ours, or any rosbag2 recording)",
+        description="Commands on ROS 2 bags: a rosbag2 folder, or a bare .mcap or .db3 file.",
+    )
+    bag_commands = bag.add_subparsers(dest="bag_command", metavar="COMMAND", parser_class=Parser)
+    bag_commands.required = True
+    info = bag_commands.add_parser(
+        "info",
+        help="print a bag's topics, types, message counts and duration",
+        description="Print a bag's storage, size, message count, time span, and per topic its "
+        "type and message count.",
+    )
+    info.add_argument("bag", metavar="BAG", type=Path, help="a bag folder, or a .mcap/.db3 file")
+
+    mapping = commands.add_parser(
+        "map",
+        help="map a recorded ROS 2 bag (LaserScan + Odometry) with cosim's mapping",
+        description=(
+            "Run the robots' mapping (scan-to-map matching correcting odometry) on a ROS 2 "
+            "bag (MCAP or sqlite3, a rosbag2 folder or a bare file) and write map.pgm + "
+            "map.yaml, map.png, trajectory.parquet/.csv (t_s, x_m, y_m, yaw_rad) and "
+            "summary.json; with --reference, the trajectory error of odometry and of the "
+            "estimate (RMS after rigid SE(2) alignment)."
+        ),
+    )
+    mapping.add_argument("bag", metavar="BAG", type=Path, help="a bag folder or .mcap/.db3 file")
+    mapping.add_argument("--out", type=Path, required=True, help="output folder")
+    mapping.add_argument("--scan", default="/scan", help="sensor_msgs/LaserScan topic (/scan)")
+    mapping.add_argument("--odom", default="/odom", help="nav_msgs/Odometry topic (/odom)")
+    mapping.add_argument(
+        "--reference",
+        metavar="TOPIC",
+        help="ground-truth poses (Odometry, PoseStamped or PoseWithCovarianceStamped) to "
+        "measure the trajectory error against",
+    )
+    mapping.add_argument(
+        "--resolution-m", type=_positive_float, default=0.05, help="map cell size (0.05 m)"
+    )
+    mapping.add_argument(
+        "--min-travel-m",
+        type=_non_negative_float,
+        default=0.5,
+        help="distance driven before a scan updates the map (slam_toolbox: 0.5 m)",
+    )
+    mapping.add_argument(
+        "--scan-matching",
+        choices=("correlative", "none"),
+        default="correlative",
+        help="correct odometry by scan matching, or none (odometry only, for comparison)",
+    )
+    mapping.add_argument(
+        "--match-margin",
+        type=_non_negative_float,
+        default=0.0,
+        help="score (0..1) by which a matched pose must beat the odometry's prediction "
+        "(default 0: corrections of noisy real odometry matter; runs use 0.02)",
+    )
+    mapping.add_argument(
+        "--no-loop-closure",
+        action="store_true",
+        help="do not close loops (scan-to-map matching only, as the robots in a run do)",
+    )
+    mapping.add_argument("--force", action="store_true", help="replace results in --out")
+    mapping.add_argument("--quiet", action="store_true", help="no progress line")
+
+    plot = commands.add_parser(
+        "plot",
+        help="draw a run's figures from its folder",
+        description=(
+            "Draw figures of a run from its folder alone (scenario.toml and tables/), so any "
+            "earlier run can be plotted: the world with trajectories, snapshots with trails, "
+            "a task timeline, the network over time, assignment convergence. PNGs go to "
+            "RUN_DIR/figures/."
+        ),
+    )
+    plot.add_argument("run_dir", metavar="RUN_DIR", type=Path, help="a run's folder")
+    plot.add_argument(
+        "--at",
+        type=_times,
+        metavar="T1,T2,...",
+        help="snapshot times (s), comma-separated (default: evenly spaced over the run)",
+    )
+    plot.add_argument("--gif", action="store_true", help="also write an animation run.gif")
+    plot.add_argument("--out", type=Path, help="folder for the figures (default RUN_DIR/figures)")
+
+    standin = commands.add_parser(
+        "standin",
+        help="run a stand-in physical robot speaking ROS 2 over DDS",
+        description=(
+            "Play a physical robot without hardware: a separate process on the DDS domain "
+            "that integrates /NAME/cmd_vel (geometry_msgs/Twist) within the robot's limits and "
+            "publishes its pose on /NAME/pose (geometry_msgs/PoseStamped, as a motion-capture "
+            "bridge would, with latency and noise) and its odometry on /NAME/odom. Runs "
+            "until Ctrl-C or --duration-s; DDS stays on loopback unless --interface is given."
+        ),
+    )
+    add_standin_arguments(standin)
+
+    commands.add_parser(
+        "scenarios",
+        help="list the presets, one line each",
+        description="List the scenario presets shipped with cosim.",
+    )
+    return parser

@@ -1,0 +1,368 @@
+"""The ``cosim`` command line.
+
+Exit status: 0 done; 2 invalid input (one line on stderr naming the file, the key, the
+value and what was expected); 1 internal failure (a bug: the traceback is printed).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import traceback
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from cosim.cli.args import EXIT_INPUT, build_parser
+from cosim.cli.progress import ProgressLine
+from cosim.core.errors import ConfigError, CosimError
+from cosim.scenario import (
+    Scenario,
+    load_scenario,
+    parse_override,
+    preset_names,
+    preset_summary,
+)
+
+
+def _count(value: Any) -> str:
+    return f"{int(value):,}"
+
+
+HIGHLIGHTS: tuple[tuple[str, str, Callable[[Any], str]], ...] = (
+    ("arrivals", "goals reached", _count),
+    ("deadlocks", "stuck reports", _count),
+    ("collisions", "collisions", _count),
+    ("min_clearance_m", "m smallest clearance", lambda v: f"{v:.2f}"),
+    ("humans_near_misses", "near misses with people", _count),
+    ("map_iou", "map IoU", lambda v: f"{v:.2f}"),
+    ("messages_dropped", "messages dropped", _count),
+    ("latency_ms_p50", "ms median latency", lambda v: f"{v:.3g}"),
+)
+"""Summary metrics shown after a run, when the run has them: key, label, format."""
+TASK_DRIVER_SKIPS = ("arrivals",)
+"""With tasks, goals reached are the tasks' legs: the tasks lead instead."""
+
+
+SINGULAR = {
+    "goals reached": "goal reached",
+    "stuck reports": "stuck report",
+    "collisions": "collision",
+    "near misses with people": "near miss with people",
+    "messages dropped": "message dropped",
+}
+
+
+def _singular(label: str) -> str:
+    return SINGULAR.get(label, label)
+
+
+def _tasks_phrase(s: dict[str, Any]) -> str | None:
+    """``12 tasks completed (6.5 per min, 24.2 s mean latency)``, with the task driver."""
+    done = s.get("tasks_completed")
+    if done is None:
+        return None
+    details = []
+    if s.get("tasks_per_min") is not None:
+        details.append(f"{s['tasks_per_min']:.3g} per min")
+    if s.get("mean_task_latency_s") is not None:
+        details.append(f"{s['mean_task_latency_s']:.3g} s mean latency")
+    noun = "task" if done == 1 else "tasks"
+    return f"{done:,} {noun} completed" + (f" ({', '.join(details)})" if details else "")
+
+
+if TYPE_CHECKING:
+    from cosim.recording.setup import RecordingSession
+    from cosim.runner.execute import RunResult
+
+EXIT_OK = 0
+EXIT_BUG = 1
+
+
+def _load(args: argparse.Namespace) -> Scenario:
+    overrides: dict[str, Any] = {}
+    for text in args.overrides:
+        key, value = parse_override(text)
+        overrides[key] = value
+    return load_scenario(args.scenario, overrides)
+
+
+def _describe(scenario: Scenario) -> str:
+    world = scenario.world
+    return (
+        f"{scenario.name} ({scenario.source}): {scenario.robots.count} robots, "
+        f"{world.size_m[0]:g} m x {world.size_m[1]:g} m, layout {world.layout}, "
+        f"{scenario.scenario.duration_s:g} s, seed {scenario.seed}"
+    )
+
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    from adapters.physical.launcher import Standins
+    from cosim.recording.foxglove import LiveOptions
+    from cosim.runner.execute import run
+
+    if args.bag is not None:
+        args.overrides.append(f"record.bag={args.bag}")
+    scenario = _load(args)
+    if args.seed is not None:
+        scenario = scenario.with_seed(args.seed)
+    out = args.out or Path("runs") / f"{scenario.name}-seed{scenario.seed}"
+    live = (
+        LiveOptions(args.live_host, args.live_port, args.live_rate, args.live_wait)
+        if args.live
+        else None
+    )
+    progress = None if args.quiet else ProgressLine(label=f"{scenario.name}: ")
+    standins = Standins(scenario) if args.standin else None
+    try:
+        if standins is not None:
+            started = standins.start()
+            if not args.quiet:
+                print(f"stand-in robots: {', '.join(started)}", flush=True)
+        result = run(
+            scenario,
+            duration_s=args.duration_s,
+            out=out,
+            force=args.force,
+            progress=progress,
+            live=live,
+            on_ready=lambda session: _ready(session, quiet=args.quiet),
+        )
+    finally:
+        if progress is not None:
+            progress.close()
+        if standins is not None:
+            standins.stop()
+    figures = []
+    if args.figures or args.gif:
+        from cosim.plotting.command import plot_run
+
+        figures = plot_run(out, gif=args.gif)
+    if not args.quiet:
+        _print_run(result, out, figures)
+    return EXIT_OK
+
+
+def _ready(session: RecordingSession, *, quiet: bool) -> None:
+    """Say where the live view is; hold the run for a viewer when asked to."""
+    live = session.live
+    if live is None:
+        return
+    if not quiet:
+        print(
+            f"live view: {live.url}  (Foxglove: Open connection > Foxglove WebSocket; "
+            f"{live.options.rate:g}x real time)",
+            flush=True,
+        )
+    if live.options.wait:
+        if not quiet:
+            print("waiting for a viewer to subscribe (Ctrl-C to stop) ...", flush=True)
+        while not live.subscribed.wait(timeout=0.5):
+            pass
+
+
+def _print_run(result: RunResult, out: Path, figures: list[Path]) -> None:
+    s = result.summary
+    factor = s.get("real_time_factor")
+    rate = f"{factor:.3g}x real time" if factor is not None else "real-time factor unknown"
+    print(
+        f"{s['scenario']} seed {s['seed']}: {s['sim_time_s']:g} s simulated in "
+        f"{s['wall_time_s']:.2f} s ({rate}), "
+        f"{s['robots']} robots, {s['events']:,} events, {s['messages_sent']:,} messages"
+    )
+    tasks = _tasks_phrase(s)
+    skip = TASK_DRIVER_SKIPS if tasks is not None else ()
+    highlights = [tasks] if tasks is not None else []
+    highlights += [
+        f"{show(s[key])} {_singular(label) if s[key] == 1 else label}"
+        for key, label, show in HIGHLIGHTS
+        if s.get(key) is not None and key not in skip
+    ]
+    if highlights:
+        print("  " + ", ".join(highlights))
+    tables = ", ".join(sorted(result.tables))
+    print(f"results: {out}/  (summary.json, scenario.toml, tables/: {tables})")
+    if result.bag is not None:
+        recorded = sum(result.recorded.values())
+        size_mb = sum(p.stat().st_size for p in result.bag.iterdir() if p.is_file()) / 1e6
+        print(
+            f"bag: {result.bag}/  ({recorded} messages on {len(result.recorded)} topics, "
+            f"{size_mb:.1f} MB; `cosim bag info {result.bag}`, or open it in Foxglove)"
+        )
+    if figures:
+        print(f"figures: {', '.join(str(f) for f in figures)}")
+
+
+def _cmd_check(args: argparse.Namespace) -> int:
+    from cosim.recording.setup import RecordingSession
+    from cosim.runner.assembly import assemble
+    from cosim.scenario import dump_scenario
+
+    scenario = _load(args)
+    # builds the world and every adapter: impossible requests fail here, as do topic
+    # patterns that match nothing the run would record
+    recording = scenario.record.bag != "none"
+    assembly = assemble(scenario, recording=recording)
+    if recording:
+        RecordingSession.topics_of(scenario, assembly.run.bus)
+    print(f"ok: {_describe(scenario)}")
+    if args.print:
+        print(dump_scenario(scenario), end="")
+    return EXIT_OK
+
+
+def _cmd_world(args: argparse.Namespace) -> int:
+    from adapters.world.warehouse import scenario_warehouse
+    from cosim.cli.world import world_command
+
+    scenario = _load(args)
+    if args.seed is not None:
+        scenario = scenario.with_seed(args.seed)
+    if not (args.png or args.map or args.sdf):
+        world = scenario_warehouse(scenario)
+        print(
+            f"{_describe(scenario)}: {len(world.shelves)} shelves, "
+            f"{len(world.obstacles)} extra obstacles, dock depth {world.dock_depth_m:.2f} m "
+            "(write files with --png, --map, --sdf)"
+        )
+        return EXIT_OK
+    for path in world_command(
+        scenario, png=args.png, map_yaml=args.map, sdf=args.sdf, resolution_m=args.resolution_m
+    ):
+        print(f"wrote {path}")
+    return EXIT_OK
+
+
+def _cmd_study(args: argparse.Namespace) -> int:
+    from cosim.studies.runner import Progress, run_study
+    from cosim.studies.spec import load_study
+
+    spec = load_study(args.study)
+    out = args.out or Path("runs") / "studies" / spec.name
+    total = len(spec.runs())
+    where = f"Dask at {args.scheduler}" if args.scheduler else f"{args.workers or 'all'} workers"
+    print(
+        f"{spec.name}: {total} runs ({len(spec.combinations())} combinations x "
+        f"{len(spec.seeds)} seeds) on {where} -> {out}/"
+    )
+    results = run_study(
+        spec,
+        out,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        resume=args.resume,
+        progress=None if args.quiet else Progress(),
+    )
+    failed = int((results["status"] != "ok").sum()) if len(results) else 0
+    print(
+        f"results: {out}/results.parquet ({len(results)} runs, {failed} failed)"
+        + (f", report: {out}/report.md" if (out / "report.md").exists() else "")
+    )
+    return EXIT_OK
+
+
+def _cmd_bag(args: argparse.Namespace) -> int:
+    from cosim.core.bags import bag_info, format_info
+
+    print(format_info(bag_info(args.bag)))
+    return EXIT_OK
+
+
+def _cmd_map(args: argparse.Namespace) -> int:
+    from cosim.cli.bagmap import map_bag
+    from models.mapping.matcher import MatcherParams
+    from models.mapping.slam import UpdateGate
+
+    progress = None if args.quiet else ProgressLine(label=f"{args.bag.name}: ")
+    try:
+        result = map_bag(
+            args.bag,
+            args.out,
+            scan_topic=args.scan,
+            odom_topic=args.odom,
+            reference_topic=args.reference,
+            resolution_m=args.resolution_m,
+            gate=UpdateGate(min_travel_m=args.min_travel_m),
+            matcher=MatcherParams(margin=args.match_margin),
+            scan_matching=args.scan_matching != "none",
+            loop_closure=not args.no_loop_closure,
+            force=args.force,
+            progress=progress,
+        )
+    finally:
+        if progress is not None:
+            progress.close()
+    s = result.summary
+    line = (
+        f"{s['scans']} scans, {s['map_updates']} map updates ({s['matched']} matched, "
+        f"{s['loop_closures']} loop closures), "
+        f"{s['recording_s']:g} s of recording in {s['wall_time_s']:g} s "
+        f"({s['real_time_factor']:g}x real time)"
+    )
+    if "ate_m" in s:
+        line += f"; trajectory error {s['ate_m']:.3f} m (odometry {s['ate_odom_m']:.3f} m)"
+    print(line)
+    print(f"results: {result.out}/  ({', '.join(p.name for p in result.files)})")
+    return EXIT_OK
+
+
+def _cmd_plot(args: argparse.Namespace) -> int:
+    from cosim.plotting.command import plot_run
+
+    for path in plot_run(args.run_dir, at=args.at, gif=args.gif, out=args.out):
+        print(f"wrote {path}")
+    return EXIT_OK
+
+
+def _cmd_scenarios(_args: argparse.Namespace) -> int:
+    names = preset_names()
+    width = max(len(n) for n in names)
+    for name in names:
+        print(f"{name:<{width}}  {preset_summary(name)}")
+    return EXIT_OK
+
+
+def _cmd_standin(args: argparse.Namespace) -> int:
+    from adapters.physical.standin import serve
+
+    return serve(args)
+
+
+COMMANDS = {
+    "run": _cmd_run,
+    "check": _cmd_check,
+    "world": _cmd_world,
+    "study": _cmd_study,
+    "bag": _cmd_bag,
+    "map": _cmd_map,
+    "plot": _cmd_plot,
+    "scenarios": _cmd_scenarios,
+    "standin": _cmd_standin,
+}
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; return the exit status."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return COMMANDS[args.command](args)
+    except (CosimError, ConfigError) as error:
+        print(f"cosim: error: {error}", file=sys.stderr)
+        return EXIT_INPUT
+    except KeyboardInterrupt:
+        print("cosim: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        # the reader left (`cosim bag info BAG | head`): stop quietly as Unix tools do, and
+        # keep the interpreter from failing to flush stdout on exit
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_OK
+    except Exception:
+        traceback.print_exc()
+        print(
+            "cosim: internal error (a bug; please report it with the traceback above)",
+            file=sys.stderr,
+        )
+        return EXIT_BUG

@@ -1,0 +1,79 @@
+"""The link between hosts: decides if and when a message reaches another host.
+
+The bus hands every inter-host transmission to a :class:`Link`. The ideal link delivers
+at once; the network model (``adapters.network.link``) decides with latency, loss, bandwidth,
+range and partitions.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from enum import StrEnum
+from typing import Protocol
+
+from cosim.core.hosts import HostId
+
+
+class DeliveryStatus(StrEnum):
+    """Fate of one message towards one destination host."""
+
+    DELIVERED = "delivered"
+    LOST = "lost"
+    QUEUE_FULL = "queue_full"
+    OUT_OF_RANGE = "out_of_range"
+    PARTITIONED = "partitioned"
+
+
+@dataclass(frozen=True, slots=True)
+class Transfer:
+    """Outcome of a transmission towards one host.
+
+    Attributes:
+        dst: destination host.
+        status: delivered or why not.
+        t_recv_ns: arrival time (ns) when delivered, else ``None``.
+    """
+
+    dst: HostId
+    status: DeliveryStatus
+    t_recv_ns: int | None
+
+
+@dataclass(frozen=True, slots=True)
+class AllDelivered:
+    """Outcome of a transmission delivered to every destination host at one instant.
+
+    The same as a :class:`Transfer` per destination, in order, each ``DELIVERED`` at
+    ``t_recv_ns``, without building them (a broadcast on an ideal network).
+
+    Attributes:
+        t_recv_ns: arrival time (ns) of every copy.
+    """
+
+    t_recv_ns: int
+
+
+class Link(Protocol):
+    """Decides the fate of messages between hosts."""
+
+    def transmit(
+        self, t_ns: int, src: HostId, dsts: Sequence[HostId], nbytes: int, topic: str
+    ) -> Sequence[Transfer] | AllDelivered:
+        """Send one message of ``nbytes`` from ``src`` at ``t_ns`` to every host in ``dsts``.
+
+        One call is one transmission: a broadcast reaches several hosts with independent
+        fates, a :class:`Transfer` each in the order of ``dsts`` (or :class:`AllDelivered`
+        when every copy arrives at one instant). Arrival times must not lie before ``t_ns``.
+        """
+        ...
+
+
+class IdealLink:
+    """A link that delivers every message instantly."""
+
+    def transmit(
+        self, t_ns: int, src: HostId, dsts: Sequence[HostId], nbytes: int, topic: str
+    ) -> AllDelivered:
+        """Deliver to every destination at ``t_ns``."""
+        return AllDelivered(t_ns)

@@ -1,0 +1,413 @@
+"""The recorder: taps the bus and collects tables, built as pandas DataFrames at the end.
+
+Rows are kept column-wise in compact buffers during the run (integers in ``array``,
+repeated strings interned as category codes) and turned into DataFrames once, so that
+recording stays cheap on the hot path. Times are recorded in integer nanoseconds and
+exported both as exact ``*_ns`` columns and as ``*_s`` seconds columns.
+"""
+
+from __future__ import annotations
+
+import math
+from array import array
+from collections.abc import Iterable, Mapping, Sequence
+from typing import Any, Protocol
+
+import numpy as np
+import numpy.typing as npt
+import pandas as pd
+
+from cosim.core.hosts import HostId
+from cosim.core.link import DeliveryStatus, Transfer
+from cosim.core.timebase import NS_PER_S
+
+
+class MapArtifact(Protocol):
+    """An occupancy map an adapter hands over for the run folder (``maps/NAME.pgm``/``.yaml``).
+
+    Attributes:
+        resolution_m: cell size (m).
+        origin_xy_m: ``map`` position of the lower-left corner of cell (0, 0) (m).
+        data: (rows, cols) int8 cells, row 0 at the lowest y: 0 free, 100 occupied, -1 unknown.
+    """
+
+    @property
+    def resolution_m(self) -> float:
+        """Cell size (m)."""
+        ...
+
+    @property
+    def origin_xy_m(self) -> tuple[float, float]:
+        """Lower-left corner of cell (0, 0) in ``map`` (m)."""
+        ...
+
+    @property
+    def data(self) -> npt.NDArray[np.int8]:
+        """The cells."""
+        ...
+
+
+class _Interner:
+    """Maps repeated strings to small integer codes."""
+
+    def __init__(self) -> None:
+        self.codes: dict[str, int] = {}
+        self.values: list[str] = []
+
+    def code(self, value: str) -> int:
+        code = self.codes.get(value)
+        if code is None:
+            code = len(self.values)
+            self.codes[value] = code
+            self.values.append(value)
+        return code
+
+    def codes_of(self, values: Sequence[str]) -> npt.NDArray[np.int32]:
+        """The codes of ``values``, new values coded in order of first appearance.
+
+        A ``str`` subclass (a ``StrEnum`` member) is coded as its plain string value.
+        """
+        for value in dict.fromkeys(values):  # the distinct values, in order
+            self.code(str(value))
+        return np.fromiter(map(self.codes.__getitem__, values), np.int32, len(values))
+
+    def categorical(self, codes: npt.NDArray[np.int32]) -> pd.Categorical[str]:
+        return pd.Categorical.from_codes(codes, categories=pd.Index(self.values))
+
+
+class Table:
+    """A table filled row by row or in column batches, rows kept in append order.
+
+    Args:
+        columns: column names in output order.
+        categorical: columns holding repeated strings (exported as ``category``).
+    """
+
+    def __init__(self, columns: Sequence[str], categorical: Iterable[str] = ()) -> None:
+        if not columns:
+            raise ValueError("a table needs at least one column")
+        self.columns = list(columns)
+        self._categorical = set(categorical)
+        self._rows: dict[str, list[Any]] = {name: [] for name in self.columns}
+        self._chunks: list[dict[str, npt.NDArray[Any]]] = []
+        self._length = 0
+
+    def append(self, **row: Any) -> None:
+        """Add one row; every column must be given."""
+        rows = self._rows
+        for name in self.columns:
+            rows[name].append(row[name])
+        self._length += 1
+
+    def extend(self, **columns: Any) -> None:
+        """Add rows from equal-length arrays; scalars are repeated to that length."""
+        self._flush_rows()
+        arrays = {name: np.asarray(columns[name]) for name in self.columns}
+        length = max((a.shape[0] for a in arrays.values() if a.ndim), default=1)
+        for name, values in arrays.items():
+            if values.ndim == 0:
+                arrays[name] = np.full(length, values.item())
+            elif values.shape[0] != length:
+                raise ValueError(f"column {name!r} has {values.shape[0]} rows, expected {length}")
+        self._chunks.append(arrays)
+        self._length += length
+
+    def _flush_rows(self) -> None:
+        if self._rows[self.columns[0]]:
+            self._chunks.append({name: np.asarray(v) for name, v in self._rows.items()})
+            self._rows = {name: [] for name in self.columns}
+
+    def __len__(self) -> int:
+        return self._length
+
+    def frame(self) -> pd.DataFrame:
+        """Return the rows as a DataFrame."""
+        self._flush_rows()
+        columns: dict[str, Any] = {}
+        for name in self.columns:
+            chunks = [chunk[name] for chunk in self._chunks]
+            values: Any = np.concatenate(chunks) if chunks else np.array([], dtype=float)
+            columns[name] = pd.Categorical(values) if name in self._categorical else values
+        return pd.DataFrame(columns, columns=self.columns)
+
+
+MESSAGE_COLUMNS = (
+    "t_sent_s",
+    "t_recv_s",
+    "src_host",
+    "dst_host",
+    "topic",
+    "bytes",
+    "status",
+    "t_sent_ns",
+    "t_recv_ns",
+)
+EVENT_COLUMNS = ("t_s", "source", "kind", "detail", "t_ns")
+
+
+_FLUSH_ROWS = 65_536
+
+
+class Recorder:
+    """Collects the run's tables: messages (from the bus tap), events, and adapter tables.
+
+    Message rows are appended column by column (a broadcast's rows in one call, see
+    :meth:`on_transmission`) and packed into NumPy columns every 65,536 rows (bounded
+    memory).
+
+    Args:
+        record_messages: keep a row per message and destination host.
+    """
+
+    def __init__(self, *, record_messages: bool = True) -> None:
+        self.record_messages = record_messages
+        self._hosts = _Interner()
+        self._topics = _Interner()
+        self._statuses = _Interner()
+        # the rows not packed yet, by column
+        self._t_sent = array("q")
+        self._t_recv = array("q")
+        self._src: list[str] = []
+        self._dst: list[str] = []
+        self._topic: list[str] = []
+        self._bytes = array("q")
+        self._status: list[str] = []
+        self._chunks: list[dict[str, npt.NDArray[Any]]] = []
+        self._events = Table(("t_ns", "source", "kind", "detail"))
+        self.tables: dict[str, Table] = {}
+        self.volatile: dict[str, tuple[str, ...]] = {}
+        self.maps: dict[str, MapArtifact] = {}
+        self.files: dict[str, bytes] = {}
+        self.counts: dict[str, int] = {status.value: 0 for status in DeliveryStatus}
+        self.network_messages = 0
+        self.network_bytes = 0
+
+    # -- the bus tap ---------------------------------------------------------------
+    def on_transfer(
+        self,
+        t_sent_ns: int,
+        t_recv_ns: int | None,
+        src: HostId,
+        dst: HostId,
+        topic: str,
+        nbytes: int,
+        status: DeliveryStatus,
+    ) -> None:
+        """Record one message towards one destination host (see :class:`cosim.core.bus.BusTap`)."""
+        self.counts[status] += 1
+        if src != dst:
+            self.network_messages += 1
+            self.network_bytes += nbytes
+        if not self.record_messages:
+            return
+        self._t_sent.append(t_sent_ns)
+        self._t_recv.append(-1 if t_recv_ns is None else t_recv_ns)
+        self._src.append(src)
+        self._dst.append(dst)
+        self._topic.append(topic)
+        self._bytes.append(nbytes)
+        self._status.append(status)
+        if len(self._src) >= _FLUSH_ROWS:
+            self._flush()
+
+    def on_transmission(
+        self, t_sent_ns: int, src: HostId, topic: str, nbytes: int, transfers: Sequence[Transfer]
+    ) -> None:
+        """Record one transmission towards several hosts: :meth:`on_transfer` for each, in order.
+
+        The same rows, counts and tables, appended a column at a time: a broadcast to 49
+        robots is one call instead of 49.
+        """
+        n = len(transfers)
+        if not n:
+            return
+        statuses = [t.status for t in transfers]
+        dsts = [t.dst for t in transfers]
+        counts = self.counts
+        for status in statuses:
+            counts[status] += 1
+        t_recv = [-1 if t.t_recv_ns is None else t.t_recv_ns for t in transfers]
+        self._rows(t_sent_ns, src, topic, nbytes, dsts, t_recv, statuses)
+
+    def on_all_delivered(
+        self,
+        t_sent_ns: int,
+        src: HostId,
+        topic: str,
+        nbytes: int,
+        dsts: Sequence[HostId],
+        t_recv_ns: int,
+    ) -> None:
+        """Record one transmission delivered to every host in ``dsts`` at ``t_recv_ns`` (ns).
+
+        The same rows, counts and tables as :meth:`on_transmission` with a delivered
+        transfer per host, without the transfers.
+        """
+        n = len(dsts)
+        if not n:
+            return
+        delivered = DeliveryStatus.DELIVERED
+        self.counts[delivered] += n
+        self._rows(t_sent_ns, src, topic, nbytes, dsts, [t_recv_ns] * n, [delivered] * n)
+
+    def _rows(
+        self,
+        t_sent_ns: int,
+        src: HostId,
+        topic: str,
+        nbytes: int,
+        dsts: Sequence[HostId],
+        t_recv_ns: list[int],
+        statuses: list[DeliveryStatus],
+    ) -> None:
+        """Network counts and (when recording) the rows of one transmission's copies."""
+        n = len(dsts)
+        others = n - dsts.count(src)
+        self.network_messages += others
+        self.network_bytes += others * nbytes
+        if not self.record_messages:
+            return
+        self._t_sent.extend([t_sent_ns] * n)
+        self._t_recv.extend(t_recv_ns)
+        self._src.extend([src] * n)
+        self._dst.extend(dsts)
+        self._topic.extend([topic] * n)
+        self._bytes.extend([nbytes] * n)
+        self._status.extend(statuses)
+        if len(self._src) >= _FLUSH_ROWS:
+            self._flush()
+
+    def _flush(self, *, rest: bool = False) -> None:
+        """Pack the pending rows in chunks of 65,536 rows, and with ``rest`` the rest too.
+
+        The chunks are those of rows packed one at a time as they come, so that hosts,
+        topics and statuses get their category codes in the same order (per chunk:
+        sources first, then destinations).
+        """
+        while len(self._src) >= (1 if rest else _FLUSH_ROWS):
+            take = min(len(self._src), _FLUSH_ROWS)
+            hosts, topics, statuses = self._hosts, self._topics, self._statuses
+            self._chunks.append(
+                {
+                    "t_sent": np.array(self._t_sent[:take], dtype=np.int64),
+                    "t_recv": np.array(self._t_recv[:take], dtype=np.int64),
+                    "src": hosts.codes_of(self._src[:take]),
+                    "dst": hosts.codes_of(self._dst[:take]),
+                    "topic": topics.codes_of(self._topic[:take]),
+                    "bytes": np.array(self._bytes[:take], dtype=np.int64),
+                    "status": statuses.codes_of(self._status[:take]),
+                }
+            )
+            for column in (
+                self._t_sent,
+                self._t_recv,
+                self._src,
+                self._dst,
+                self._topic,
+                self._bytes,
+                self._status,
+            ):
+                del column[:take]
+
+    # -- events and adapter tables ---------------------------------------------------
+    def event(self, t_ns: int, source: str, kind: str, detail: str = "") -> None:
+        """Record a discrete event (``source`` is the component, ``kind`` a short verb)."""
+        self._events.append(t_ns=t_ns, source=source, kind=kind, detail=detail)
+
+    def table(
+        self,
+        name: str,
+        columns: Sequence[str],
+        categorical: Iterable[str] = (),
+        *,
+        volatile: Iterable[str] = (),
+    ) -> Table:
+        """Create (once) and return the table ``name``; it is exported as ``tables/NAME``.
+
+        Args:
+            name: table name.
+            columns: column names, in order.
+            categorical: columns of repeated strings.
+            volatile: wall-clock columns (e.g. a planning time in ms): the only values
+                that are not a function of the scenario and seed; comparisons of runs
+                leave them out (see :attr:`volatile`).
+        """
+        if name in self.tables or name in ("messages", "events"):
+            raise ValueError(f"table {name!r} exists already")
+        table = Table(columns, categorical)
+        self.tables[name] = table
+        for column in volatile:
+            if column not in columns:
+                raise ValueError(f"volatile column {column!r} is not a column of {name!r}")
+        self.volatile[name] = tuple(volatile)
+        return table
+
+    def add_map(self, name: str, grid: MapArtifact) -> None:
+        """Keep a final map for the run folder (``maps/NAME``)."""
+        if name in self.maps:
+            raise ValueError(f"map {name!r} exists already")
+        self.maps[name] = grid
+
+    def add_file(self, relative: str, data: bytes) -> None:
+        """Keep a file for the run folder, at ``relative`` (e.g. ``sumo/aisles.net.xml``)."""
+        if relative in self.files:
+            raise ValueError(f"file {relative!r} exists already")
+        self.files[relative] = data
+
+    # -- export ----------------------------------------------------------------------
+    def messages_frame(self) -> pd.DataFrame:
+        """The messages table: one row per message and destination host."""
+        self._flush(rest=True)
+
+        def column(name: str, dtype: type) -> npt.NDArray[Any]:
+            parts = [chunk[name] for chunk in self._chunks]
+            return np.concatenate(parts) if parts else np.zeros(0, dtype=dtype)
+
+        t_sent = column("t_sent", np.int64)
+        t_recv = column("t_recv", np.int64)
+        received = t_recv >= 0
+        t_recv_s = np.where(received, t_recv / NS_PER_S, math.nan)
+        return pd.DataFrame(
+            {
+                "t_sent_s": t_sent / NS_PER_S,
+                "t_recv_s": t_recv_s,
+                "src_host": self._hosts.categorical(column("src", np.int32)),
+                "dst_host": self._hosts.categorical(column("dst", np.int32)),
+                "topic": self._topics.categorical(column("topic", np.int32)),
+                "bytes": column("bytes", np.int64),
+                "status": self._statuses.categorical(column("status", np.int32)),
+                "t_sent_ns": t_sent,
+                "t_recv_ns": pd.arrays.IntegerArray(np.where(received, t_recv, 0), ~received),
+            },
+            columns=list(MESSAGE_COLUMNS),
+        )
+
+    def events_frame(self) -> pd.DataFrame:
+        """The events table (t_s, source, kind, detail, t_ns)."""
+        frame = self._events.frame()
+        t_ns = frame["t_ns"].to_numpy(dtype=np.int64)
+        frame = frame.assign(t_s=t_ns / NS_PER_S, t_ns=t_ns)
+        for column in ("source", "kind"):
+            frame[column] = frame[column].astype("category")
+        frame["detail"] = frame["detail"].astype(str)
+        return frame[list(EVENT_COLUMNS)]
+
+    def frames(self) -> dict[str, pd.DataFrame]:
+        """Every table as a DataFrame, keyed by table name."""
+        frames = {"messages": self.messages_frame(), "events": self.events_frame()}
+        for name, table in self.tables.items():
+            frames[name] = table.frame()
+        return frames
+
+
+def ns_column(values: npt.ArrayLike) -> npt.NDArray[np.float64]:
+    """Convert an array of integer nanoseconds to float seconds."""
+    return np.asarray(values, dtype=np.int64) / NS_PER_S
+
+
+def merge_counts(into: dict[str, Any], extra: Mapping[str, Any]) -> None:
+    """Merge summary entries, refusing to overwrite an existing key."""
+    for key, value in extra.items():
+        if key in into:
+            raise ValueError(f"summary key {key!r} reported twice")
+        into[key] = value

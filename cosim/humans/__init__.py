@@ -1,1 +1,0 @@
-"""SUMO co-simulation: the files SUMO reads and a running SUMO session."""

@@ -1,1 +1,0 @@
-"""Motion capture outside the kernel: recorded pose tracks and live mocap systems."""

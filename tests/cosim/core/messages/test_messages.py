@@ -1,0 +1,192 @@
+import dataclasses
+
+import numpy as np
+import pytest
+from rosbags.typesys import Stores, get_typestore
+
+from cosim.core.messages import Goal, LaserScan, Odometry, PoseStamped, Twist
+
+STORE = get_typestore(Stores.ROS2_JAZZY)
+
+
+def _ros(typename: str):
+    return STORE.types[typename]
+
+
+def _header(stamp_ns: int, frame_id: str):
+    time = _ros("builtin_interfaces/msg/Time")(sec=stamp_ns // 10**9, nanosec=stamp_ns % 10**9)
+    return _ros("std_msgs/msg/Header")(stamp=time, frame_id=frame_id)
+
+
+def _pose():
+    point = _ros("geometry_msgs/msg/Point")(x=1.0, y=2.0, z=0.0)
+    quat = _ros("geometry_msgs/msg/Quaternion")(x=0.0, y=0.0, z=0.0, w=1.0)
+    return _ros("geometry_msgs/msg/Pose")(position=point, orientation=quat)
+
+
+def _vector():
+    return _ros("geometry_msgs/msg/Vector3")(x=0.0, y=0.0, z=0.0)
+
+
+def _cdr_size(typename: str, message) -> int:
+    return len(STORE.serialize_cdr(message, typename))
+
+
+def test_twist_size_matches_the_cdr_serialization_of_rosbags():
+    ros = _ros("geometry_msgs/msg/Twist")(linear=_vector(), angular=_vector())
+    assert Twist(1.0, 0.5).size_bytes() == _cdr_size(Twist.ros_type, ros)
+
+
+@pytest.mark.parametrize("frame", ["map", "robot_12/odom", ""])
+def test_pose_stamped_size_matches_the_cdr_serialization_of_rosbags(frame):
+    ros = _ros("geometry_msgs/msg/PoseStamped")(header=_header(5, frame), pose=_pose())
+    assert PoseStamped(5, frame, 1.0, 2.0, 0.0).size_bytes() == _cdr_size(PoseStamped.ros_type, ros)
+
+
+def test_goal_is_sized_as_a_pose_stamped_in_map():
+    ros = _ros("geometry_msgs/msg/PoseStamped")(header=_header(5, "map"), pose=_pose())
+    assert Goal(5, 1.0, 2.0).size_bytes() == _cdr_size(Goal.ros_type, ros)
+
+
+@pytest.mark.parametrize(("frame", "child"), [("odom", "base_link"), ("robot_1/odom", "a")])
+def test_odometry_size_matches_the_cdr_serialization_of_rosbags(frame, child):
+    cov = np.zeros(36)
+    pose = _ros("geometry_msgs/msg/PoseWithCovariance")(pose=_pose(), covariance=cov)
+    twist = _ros("geometry_msgs/msg/Twist")(linear=_vector(), angular=_vector())
+    twist_cov = _ros("geometry_msgs/msg/TwistWithCovariance")(twist=twist, covariance=cov)
+    ros = _ros("nav_msgs/msg/Odometry")(
+        header=_header(7, frame), child_frame_id=child, pose=pose, twist=twist_cov
+    )
+    ours = Odometry(7, frame, child, 0.0, 0.0, 0.0, 0.0, 0.0)
+    assert ours.size_bytes() == _cdr_size(Odometry.ros_type, ros)
+
+
+@pytest.mark.parametrize("beams", [0, 1, 360, 1081])
+def test_laser_scan_size_matches_the_cdr_serialization_of_rosbags(beams):
+    ranges = np.ones(beams, dtype=np.float32)
+    ros = _ros("sensor_msgs/msg/LaserScan")(
+        header=_header(9, "robot_1/laser"),
+        angle_min=-3.14,
+        angle_max=3.14,
+        angle_increment=0.01,
+        time_increment=0.0,
+        scan_time=0.1,
+        range_min=0.1,
+        range_max=10.0,
+        ranges=ranges,
+        intensities=np.zeros(0, dtype=np.float32),
+    )
+    ours = LaserScan(9, "robot_1/laser", -3.14, 0.01, 0.1, 10.0, 0.1, ranges)
+    assert ours.size_bytes() == _cdr_size(LaserScan.ros_type, ros)
+
+
+def test_messages_are_immutable_including_scan_ranges():
+    scan = LaserScan(0, "laser", 0.0, 0.1, 0.1, 10.0, 0.1, np.ones(4, dtype=np.float32))
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        scan.stamp_ns = 5  # type: ignore[misc]
+    with pytest.raises(ValueError):
+        scan.ranges_m[0] = 3.0
+
+
+def _cosim_store():
+    from rosbags.typesys import get_typestore
+    from rosbags.typesys.msg import get_types_from_msg
+
+    from cosim.core.messages.definitions import DEFINITIONS
+
+    store = get_typestore(Stores.ROS2_JAZZY)
+    types = {}
+    for name, text in DEFINITIONS.items():
+        types.update(get_types_from_msg(text, name))
+    store.register(types)
+    return store
+
+
+COSIM = _cosim_store()
+
+
+def _size(name, **fields):
+    return len(COSIM.serialize_cdr(COSIM.types[name](**fields), name))
+
+
+def _hdr(stamp_ns=5, frame="map"):
+    time = COSIM.types["builtin_interfaces/msg/Time"](sec=0, nanosec=stamp_ns)
+    return COSIM.types["std_msgs/msg/Header"](stamp=time, frame_id=frame)
+
+
+def test_project_message_sizes_match_their_msg_definitions():
+    from cosim.core.messages import (
+        AuctionBids,
+        NavGoal,
+        NavStatus,
+        RobotState,
+        ServiceReply,
+        ServiceRequest,
+        SimplexBasis,
+        TaskClaim,
+        TaskDone,
+        TaskInfo,
+        TaskOrder,
+        TaskSet,
+    )
+
+    def info(t):
+        return COSIM.types["cosim_msgs/msg/TaskInfo"](
+            task_id=t.task_id, x=t.x_m, y=t.y_m, eligible=list(t.eligible), holder=t.holder
+        )
+
+    def column(c):
+        return COSIM.types["cosim_msgs/msg/SimplexColumn"](
+            kind=c[0], robot=c[1], task=c[2], cost=c[3]
+        )
+
+    tasks = (TaskInfo(3, 1.0, 2.0, ("robot_1", "robot_12"), "robot_1"), TaskInfo(7, 5.0, 6.0, ()))
+    columns = ((0, 1, 2, 3.5), (1, 2, -1, 0.0), (2, -1, 4, 1e6))
+    cases = [
+        (NavGoal(5, 4, 1.0, 2.0), dict(header=_hdr(), goal_id=4, x=1.0, y=2.0, yaw=0.0)),
+        (
+            NavStatus(5, 4, "progress", 1.0, 2.0, 3.0),
+            dict(header=_hdr(), goal_id=4, state="progress", x=1.0, y=2.0, remaining=3.0),
+        ),
+        (
+            RobotState(5, "robot_3", 1.0, 2.0, 0.1, 0.5, 0.33),
+            dict(header=_hdr(), robot="robot_3", x=1.0, y=2.0, yaw=0.1, v=0.5, radius=0.33),
+        ),
+        (TaskSet(5, 2, tasks), dict(header=_hdr(), epoch=2, tasks=[info(t) for t in tasks])),
+        (
+            TaskClaim(5, 2, 3, "robot_1", 4.5, "release"),
+            dict(header=_hdr(), epoch=2, task_id=3, robot="robot_1", cost=4.5, state="release"),
+        ),
+        (ServiceRequest(5, 3, "robot_1"), dict(header=_hdr(), task_id=3, robot="robot_1")),
+        (
+            ServiceReply(5, 3, "robot_1", True),
+            dict(header=_hdr(), task_id=3, robot="robot_1", granted=True),
+        ),
+        (TaskDone(5, 3, "robot_10"), dict(header=_hdr(), task_id=3, robot="robot_10")),
+        (
+            SimplexBasis(5, 2, "robot_1", 7, columns),
+            dict(
+                header=_hdr(),
+                epoch=2,
+                robot="robot_1",
+                round=7,
+                columns=[column(c) for c in columns],
+            ),
+        ),
+        (
+            AuctionBids(5, 2, "robot_1", (1.0, 2.0, 3.0), (0, -1, 2)),
+            dict(
+                header=_hdr(),
+                epoch=2,
+                robot="robot_1",
+                bids=np.array([1.0, 2.0, 3.0]),
+                winners=np.array([0, -1, 2], dtype=np.int32),
+            ),
+        ),
+        (
+            TaskOrder(5, 2, "robot_1", -1, 0.0),
+            dict(header=_hdr(), epoch=2, robot="robot_1", task_id=-1, cost=0.0),
+        ),
+    ]
+    for message, fields in cases:
+        assert message.size_bytes() == _size(message.ros_type, **fields), message.ros_type

@@ -1,0 +1,54 @@
+import pytest
+
+from cosim.core.errors import RegistryError
+from cosim.core.registry import AdapterRegistry
+
+
+class _A:
+    name = "a"
+    requires: tuple[str, ...] = ()
+
+
+class _B:
+    name = "b"
+    requires = ("a",)
+
+
+class _C:
+    name = "c"
+    requires = ("b", "a")
+
+
+class _Loop1:
+    name = "loop1"
+    requires = ("loop2",)
+
+
+class _Loop2:
+    name = "loop2"
+    requires = ("loop1",)
+
+
+REG = AdapterRegistry({"a": _A, "b": _B, "c": _C, "loop1": _Loop1, "loop2": _Loop2})  # type: ignore[dict-item]
+
+
+def test_an_unknown_adapter_name_suggests_the_nearest_names():
+    registry = AdapterRegistry.from_entry_points()
+    with pytest.raises(RegistryError, match=r"unknown adapter 'lidr'; did you mean 'lidar'"):
+        registry.get("lidr")
+
+
+def test_requirements_are_ordered_before_the_adapters_that_need_them():
+    assert REG.resolve(["c"]) == ["a", "b", "c"]
+    assert REG.resolve(["b", "a", "c"]) == ["a", "b", "c"]
+
+
+def test_a_requirement_cycle_is_an_error_naming_the_cycle():
+    with pytest.raises(RegistryError, match="loop1 -> loop2 -> loop1"):
+        REG.resolve(["loop1"])
+
+
+def test_the_installed_registry_comes_from_entry_points():
+    names = AdapterRegistry.from_entry_points().names()
+    assert names == sorted(names)
+    assert "fleet" in names
