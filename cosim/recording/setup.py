@@ -17,8 +17,8 @@ from cosim.core.bus import Advertisement, Bus
 from cosim.recording.bag import BAG_DIR, BagSink
 from cosim.recording.foxglove import LiveOptions, LiveSink
 from cosim.recording.schemas import channel_specs
-from cosim.recording.tap import RecordingTap, Sink
 from cosim.recording.selection import select_topics
+from cosim.recording.tap import RecordingTap, Sink
 from cosim.scenario.model import Scenario
 
 
