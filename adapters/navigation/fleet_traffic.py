@@ -68,8 +68,7 @@ from adapters.navigation.places import (
 from cosim.core.errors import ConfigError
 from cosim.core.timebase import s_to_ns
 from cosim.scenario.model import Scenario
-from models.arrays import BoolArray, FloatArray, IntArray, UInt8Array
-from models.navigation.costmap import StaticCostmap
+from models.arrays import BoolArray, FloatArray, IntArray
 from models.navigation.pibt import Pibt
 
 URGENT_S = 10.0
@@ -118,23 +117,14 @@ def check_localization(scenario: Scenario, tracked: BoolArray) -> None:
 
 
 class FleetTraffic:
-    """PIBT steps for the whole fleet over its places (:class:`FleetPlaces`).
+    """PIBT steps for the whole fleet over its places.
 
     Args:
-        static: the building's static costmap.
-        lanes: one-way lanes on the static costmap's cells
-            (:func:`models.navigation.lanes.aisle_lanes`).
-        poses: (n, 2) start positions (m) in ``map``.
-        radius_m: robot footprint radius (m).
-
-    Raises:
-        ModelError: when the floor has fewer places than robots.
+        places: the fleet's places, holds and goals (stepped in place).
     """
 
-    def __init__(
-        self, static: StaticCostmap, lanes: UInt8Array, poses: FloatArray, radius_m: float
-    ) -> None:
-        self.places = FleetPlaces(static, lanes, poses, radius_m)
+    def __init__(self, places: FleetPlaces) -> None:
+        self.places = places
 
     def step(
         self, poses: FloatArray, active: BoolArray, progress_ns: IntArray, now_ns: int

@@ -32,6 +32,7 @@ from adapters.navigation.goal_tracking import Drivers, GoalTracker
 from adapters.navigation.layers import lanes_on, robot_layers, static_costmap
 from adapters.navigation.local_control import DwaControl
 from adapters.navigation.localization import Localization
+from adapters.navigation.places import FleetPlaces
 from adapters.navigation.planning import GlobalPlanning
 from adapters.navigation.recovery import Recovery, StallWatch
 from adapters.navigation.robots_layer import RobotsLayer
@@ -113,12 +114,13 @@ class NavigationAdapter:
             self.lanes = lanes_on(self.layers[0], truth, LANE_WIDTH_M)
         self.manager: FleetTraffic | None = None
         if cfg.traffic == "pibt":  # the fleet manager moves every robot place by place
-            self.manager = FleetTraffic(
+            places = FleetPlaces(
                 self.static,
                 lanes_on(self.static, truth, LANE_WIDTH_M),
                 np.stack([self.fleet.x, self.fleet.y], axis=1),
                 radius,
             )
+            self.manager = FleetTraffic(places)
         run.provide(self.static)
         self.localization = Localization(run, self.fleet, mapping=self.mapping)
         self.measured = self.localization.measured

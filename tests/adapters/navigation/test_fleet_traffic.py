@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 import adapters.navigation.fleet_traffic as fleet_traffic
 import cosim
 from adapters.navigation.fleet_traffic import FleetTraffic
-from adapters.navigation.places import CLEARANCE_M, MOVE, STAND
+from adapters.navigation.places import CLEARANCE_M, MOVE, STAND, FleetPlaces
 from cosim.runner.assembly import check_scenario
 from models.errors import ModelError
 from models.navigation.costmap import CostmapParams, StaticCostmap
@@ -77,7 +77,7 @@ def test_a_fleet_with_more_robots_than_places_is_refused_naming_the_key():
     lanes = np.full(static.cost.shape, TWO_WAY, dtype=np.uint8)
     positions = np.full((20, 2), 1.5)
     with pytest.raises(ModelError, match=r"robots\.count"):
-        FleetTraffic(static, lanes, positions, 0.33)
+        FleetTraffic(FleetPlaces(static, lanes, positions, 0.33))
 
 
 @pytest.mark.parametrize(
@@ -125,7 +125,9 @@ def test_a_robot_waiting_on_its_goals_place_keeps_the_free_places_it_needs():
     occupancy[0, :] = occupancy[-1, :] = occupancy[:, 0] = occupancy[:, -1] = 100
     static = StaticCostmap.from_grid(OccupancyGrid(0.1, (0.0, 0.0), occupancy), CostmapParams(0.33))
     lanes = np.full(static.cost.shape, TWO_WAY, dtype=np.uint8)
-    traffic = FleetTraffic(static, lanes, np.array([[1.5, 1.5], [3.0, 3.0], [4.5, 4.5]]), 0.33)
+    traffic = FleetTraffic(
+        FleetPlaces(static, lanes, np.array([[1.5, 1.5], [3.0, 3.0], [4.5, 4.5]]), 0.33)
+    )
     roadmap = build_roadmap(
         static.distance_m, static.origin_xy_m, 0.1, traffic.places.spacing_m, 0.33 + CLEARANCE_M
     )
@@ -166,7 +168,7 @@ def test_a_robot_that_landed_on_its_next_place_is_driving_off_the_place_it_still
     occupancy[0, :] = occupancy[-1, :] = occupancy[:, 0] = occupancy[:, -1] = 100
     static = StaticCostmap.from_grid(OccupancyGrid(0.1, (0.0, 0.0), occupancy), CostmapParams(0.33))
     lanes = np.full(static.cost.shape, TWO_WAY, dtype=np.uint8)
-    traffic = FleetTraffic(static, lanes, np.array([[1.5, 1.5]]), 0.33)
+    traffic = FleetTraffic(FleetPlaces(static, lanes, np.array([[1.5, 1.5]]), 0.33))
     roadmap = build_roadmap(
         static.distance_m, static.origin_xy_m, 0.1, traffic.places.spacing_m, 0.33 + CLEARANCE_M
     )
@@ -204,7 +206,7 @@ def test_a_robot_that_let_another_through_off_its_goals_place_keeps_its_places_c
     occupancy[0, :] = occupancy[-1, :] = occupancy[:, 0] = occupancy[:, -1] = 100
     static = StaticCostmap.from_grid(OccupancyGrid(0.1, (0.0, 0.0), occupancy), CostmapParams(0.33))
     lanes = np.full(static.cost.shape, TWO_WAY, dtype=np.uint8)
-    traffic = FleetTraffic(static, lanes, np.array([[1.5, 1.5], [4.5, 4.5]]), 0.33)
+    traffic = FleetTraffic(FleetPlaces(static, lanes, np.array([[1.5, 1.5], [4.5, 4.5]]), 0.33))
     roadmap = build_roadmap(
         static.distance_m, static.origin_xy_m, 0.1, traffic.places.spacing_m, 0.33 + CLEARANCE_M
     )
