@@ -15,7 +15,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from adapters.assignment.protocols import AssignmentProtocol
+from adapters.assignment.contract import ProtocolAgent
 from adapters.assignment.tables import DtaRecords
 from adapters.assignment.topics import ASSIGNMENT, CLAIMS, DONE, SERVICE_REQUESTS
 from adapters.naming import topic
@@ -57,7 +57,7 @@ class RobotTasks:
     epoch: int = 0
     tasks: tuple[TaskInfo, ...] = ()
     costs: tuple[float, ...] = ()
-    protocol: AssignmentProtocol | None = None
+    protocol: ProtocolAgent | None = None
     acted: bool = False
     inbox: list[Message] = field(default_factory=list)
     claims: dict[int, tuple[str, float]] = field(default_factory=dict)

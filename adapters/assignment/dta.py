@@ -24,17 +24,16 @@ from typing import Any, ClassVar
 import numpy as np
 
 from adapters.assignment.commitments import Commitments, RobotTasks
-from adapters.assignment.protocols import (
-    BasisDecoder,
-    CbbaProtocol,
-    GreedyProtocol,
-    SimplexProtocol,
+from adapters.assignment.contract import (
+    EpochView,
+    ProtocolFleet,
+    ProtocolInUse,
+    protocol_registry,
 )
+from adapters.assignment.settings import AssignmentConfig
 from adapters.assignment.tables import DtaRecords
 from adapters.assignment.topics import (
     ASSIGNMENT,
-    BASES,
-    BIDS,
     CLAIMS,
     DONE,
     REPORTS,
@@ -46,12 +45,12 @@ from adapters.assignment.topics import (
 )
 from adapters.naming import topic
 from adapters.network.link import NetworkView
+from adapters.tasks.settings import TasksConfig
 from cosim.core.adapter import RunContext
 from cosim.core.bus import Envelope
 from cosim.core.hosts import HostId
 from cosim.core.kernel import Stage
 from cosim.core.messages import (
-    AuctionBids,
     Message,
     NavGoal,
     NavStatus,
@@ -59,7 +58,6 @@ from cosim.core.messages import (
     RobotState,
     ServiceReply,
     ServiceRequest,
-    SimplexBasis,
     TaskAssignment,
     TaskClaim,
     TaskDone,
@@ -68,7 +66,6 @@ from cosim.core.messages import (
     TaskSet,
 )
 from cosim.core.timebase import period_ns, s_to_ns
-from cosim.scenario.sections import AssignmentConfig, TasksConfig
 from models.assignment.problem import AssignmentProblem
 from models.kinematics import FleetState
 from models.navigation.costmap import StaticCostmap
@@ -96,14 +93,16 @@ class DtaAdapter:
         robots, edges = view.robot_graph()
         bound = self.cfg.diameter_bound or diameter(robots, edges)
         self.diameter = int(bound) if math.isfinite(bound) else len(robots) - 1
-        self.decoder = BasisDecoder()
         self.period_ns = period_ns(1000.0 / self.cfg.period_ms)
         self.rebroadcast_ns = s_to_ns(self.cfg.rebroadcast_s)
-        # a common bid reward above any travel cost in the hall (paths included)
-        width, height = run.service(Warehouse).size_m
-        self.reward_m = 10.0 * float(math.hypot(width, height))
+        protocol_type = protocol_registry().get(self.cfg.protocol)
+        fleet_view = ProtocolFleet(
+            run, tuple(self.names), self.diameter, run.service(Warehouse).size_m
+        )
+        self.protocol = protocol_type(fleet_view)
+        run.provide(ProtocolInUse(self.protocol))
         self.records = DtaRecords(
-            run.recorder, self.names, compare=self.cfg.protocol in ("distributed_simplex", "cbba")
+            run.recorder, self.names, compare=protocol_type.compare_to_optimum
         )
         self.duties = Commitments(
             self.names,
@@ -124,12 +123,10 @@ class DtaAdapter:
         bus.advertise(CLAIMS, TaskClaim)
         bus.advertise(SERVICE_REQUESTS, ServiceRequest)
         bus.advertise(DONE, TaskDone)
-        protocol = self.cfg.protocol
-        if protocol == "distributed_simplex":
-            bus.advertise(BASES, SimplexBasis)
-        elif protocol == "cbba":
-            bus.advertise(BIDS, AuctionBids)
-        elif protocol == "hungarian":
+        protocol = self.protocol
+        if protocol.topic is not None and protocol.message is not None:
+            bus.advertise(protocol.topic, protocol.message)
+        if protocol.central:
             bus.advertise(REPORTS, RobotState)
         bus.advertise(ASSIGNMENT, TaskAssignment)
 
@@ -141,8 +138,8 @@ class DtaAdapter:
             on = self._on(run, robot)
             bus.subscribe(TASKS, host, on)
             bus.subscribe(CLAIMS, host, on)
-            bus.subscribe(BASES, host, on)
-            bus.subscribe(BIDS, host, on)
+            if self.protocol.topic is not None:
+                bus.subscribe(self.protocol.topic, host, on)
             bus.subscribe(reply_topic(robot.name), host, on)
             bus.subscribe(ack_topic(robot.name), host, on)
             bus.subscribe(order_topic(robot.name), host, on)
@@ -163,17 +160,20 @@ class DtaAdapter:
                     stage=Stage.CONTROL,
                     start_ns=now_ns + int(phase),
                 )
-        if self.cfg.protocol == "hungarian":
+        if self.protocol.central:  # the base station decides from the robots' poses
             run.kernel.every(s_to_ns(1.0), lambda now: self._report(run, now), stage=Stage.CONTROL)
 
     def _on(self, run: RunContext, robot: RobotTasks) -> Callable[[Message, Envelope], None]:
+        exchanged = self.protocol.message
+
         def on(message: Message, envelope: Envelope) -> None:
             if isinstance(message, Odometry):
                 self.pose[robot.index] = (message.x_m, message.y_m)
             elif isinstance(message, TaskSet):
                 self._on_tasks(run, robot, message)
-            elif isinstance(message, SimplexBasis | AuctionBids):
-                if message.epoch == robot.epoch and message.robot != robot.name:
+            elif exchanged is not None and isinstance(message, exchanged):
+                sender: Any = message  # the contract: protocol messages carry epoch and robot
+                if sender.epoch == robot.epoch and sender.robot != robot.name:
                     robot.inbox.append(message)
             elif isinstance(message, TaskClaim):
                 self.duties.on_claim(run, robot, message)
@@ -201,25 +201,14 @@ class DtaAdapter:
         robot.blocked = {t: until for t, until in robot.blocked.items() if until > now}
         problem = self._problem(robot, tasks.tasks)
         robot.costs = tuple(problem.cost[robot.index].tolist())
-        protocol = self.cfg.protocol
-        if protocol == "distributed_simplex":
-            robot.protocol = SimplexProtocol(
-                problem, robot.index, robot.name, tasks.epoch, self.diameter, self.decoder
-            )
-        elif protocol == "cbba":
-            robot.protocol = CbbaProtocol(
-                problem, robot.index, robot.name, tasks.epoch, self.diameter, self.reward_m
-            )
-        elif protocol == "greedy":
-            taken = {
-                j
-                for j, t in enumerate(tasks.tasks)
-                if (t.holder and t.holder != robot.name)
-                or (t.task_id in robot.claims and robot.claims[t.task_id][0] != robot.name)
-            }
-            robot.protocol = GreedyProtocol(problem, robot.index, taken)
-        else:
-            robot.protocol = None  # orders come from the base station
+        taken = frozenset(
+            j
+            for j, t in enumerate(tasks.tasks)
+            if (t.holder and t.holder != robot.name)
+            or (t.task_id in robot.claims and robot.claims[t.task_id][0] != robot.name)
+        )
+        view = EpochView(problem, robot.index, robot.name, tasks.epoch, tasks.tasks, taken)
+        robot.protocol = self.protocol.agent(view)  # None: orders come from the base station
         self.records.epoch_seen(robot.index, tasks.epoch, tasks.stamp_ns, problem)
 
     def _problem(self, robot: RobotTasks, tasks: tuple[TaskInfo, ...]) -> AssignmentProblem:
@@ -271,8 +260,8 @@ class DtaAdapter:
             changed or not was_decided or now_ns - robot.last_broadcast_ns >= self.rebroadcast_ns
         )
         if send and message is not None:
-            host = self.hosts[robot.index]
-            run.bus.publish(BASES if isinstance(message, SimplexBasis) else BIDS, message, host)
+            assert self.protocol.topic is not None, f"{self.cfg.protocol} sent with no topic"
+            run.bus.publish(self.protocol.topic, message, self.hosts[robot.index])
             robot.last_broadcast_ns = now_ns
         if not was_decided or changed:
             self.records.round(
@@ -309,6 +298,5 @@ class DtaAdapter:
     def finish(self, run: RunContext) -> Mapping[str, Any]:
         """Convergence, rounds, optimality gap, conflicts seen by robots."""
         summary = self.records.summary()
-        if self.cfg.protocol == "hungarian":
-            summary["optimality_gap"] = 0.0  # the optimum of the base's instance, by construction
+        summary.update(self.protocol.summary())
         return summary

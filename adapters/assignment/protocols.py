@@ -1,23 +1,30 @@
-"""The assignment protocols a robot can run in an epoch, behind one small interface.
+"""cosim's own assignment protocols, registered in ``cosim.protocols`` as a plugin's are.
 
-Each protocol instance belongs to one robot and one epoch (one assignment problem). Every
-round it takes the protocol messages received since the last round and returns what to
-broadcast; once it has *decided*, :meth:`task` is the task index it should serve (or
-``None``). A decision may still change when late information arrives (the robot then
-re-targets).
+- ``distributed_simplex``: distributed simplex (Buerger, Notarstefano, Bullo, Allgoewer
+  2012), the protocol of ChoiRbot and VirTooS: robots exchange bases and halt together;
+- ``cbba``: a consensus-based auction (CBAA, Choi, Brunet, How 2009);
+- ``greedy``: each robot takes the nearest task nobody has claimed, exchanging nothing;
+- ``hungarian``: the centralized optimum (Kuhn's Hungarian method, scipy) on the base station.
+
+Each agent (``SimplexProtocol``, ...) belongs to one robot and one epoch (one assignment
+problem); see :mod:`adapters.assignment.contract` for what a protocol and its agents do.
 """
 
 from __future__ import annotations
 
-from typing import Protocol
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any, ClassVar
 
 import numpy as np
 
-from cosim.core.messages import AuctionBids, Message, SimplexBasis
+from adapters.assignment.contract import EpochView, ProtocolAgent, ProtocolBase, ProtocolFleet
+from adapters.assignment.topics import BASES, BIDS
+from cosim.core.messages import AuctionBids, Message, SimplexBasis, TaskInfo
 from models.assignment.cbaa import CbaaAgent, scores_from_cost
 from models.assignment.dsimplex import SharedBasis, agent_for
 from models.assignment.greedy import nearest_free
-from models.assignment.problem import AssignmentProblem
+from models.assignment.problem import AssignmentProblem, hungarian
 
 
 class BasisDecoder:
@@ -43,36 +50,6 @@ class BasisDecoder:
         columns = SharedBasis.from_rows(message.columns)
         self._last[message.robot] = (message.columns, columns)
         return columns
-
-
-class AssignmentProtocol(Protocol):
-    """One robot's side of an assignment protocol in one epoch."""
-
-    def round(self, inbox: list[Message], now_ns: int) -> tuple[Message | None, bool]:
-        """Run one round on the received messages; return (message to send, state changed)."""
-        ...
-
-    @property
-    def decided(self) -> bool:
-        """Whether the robot may act on :meth:`task`."""
-        ...
-
-    def task(self) -> int | None:
-        """Index of the task this robot should serve, or None."""
-        ...
-
-    @property
-    def rounds(self) -> int:
-        """Rounds run so far."""
-        ...
-
-    def cost(self) -> float:
-        """This robot's current view of the assignment objective (m + big-M terms)."""
-        ...
-
-    def view(self) -> dict[int, int]:
-        """This robot's view of the whole assignment (robot index -> task index)."""
-        ...
 
 
 class SimplexProtocol:
@@ -231,3 +208,92 @@ class GreedyProtocol:
     def view(self) -> dict[int, int]:
         """Only this robot's own choice."""
         return {self.robot: self.choice} if self.choice is not None else {}
+
+
+class DistributedSimplex(ProtocolBase):
+    """Distributed simplex (Buerger et al. 2012, as in ChoiRbot): robots exchange LP bases."""
+
+    name: ClassVar[str] = "distributed_simplex"
+    message: ClassVar[type[Message] | None] = SimplexBasis
+    topic: ClassVar[str | None] = BASES
+    compare_to_optimum: ClassVar[bool] = True
+
+    def __init__(self, fleet: ProtocolFleet) -> None:
+        super().__init__(fleet)
+        # one decoder for the fleet: a sender's wire basis is laid out once for all receivers
+        self.decoder = BasisDecoder()
+
+    def agent(self, epoch: EpochView) -> ProtocolAgent:
+        """A simplex agent on the robot's own columns."""
+        return SimplexProtocol(
+            epoch.problem, epoch.robot, epoch.name, epoch.epoch, self.fleet.diameter, self.decoder
+        )
+
+
+class Cbba(ProtocolBase):
+    """Consensus-based auction (CBAA, Choi, Brunet, How 2009): robots exchange bids."""
+
+    name: ClassVar[str] = "cbba"
+    message: ClassVar[type[Message] | None] = AuctionBids
+    topic: ClassVar[str | None] = BIDS
+    compare_to_optimum: ClassVar[bool] = True
+
+    def __init__(self, fleet: ProtocolFleet) -> None:
+        super().__init__(fleet)
+        # a common bid reward above any travel cost in the hall (paths included)
+        width, height = fleet.hall_size_m
+        self.reward_m = 10.0 * float(math.hypot(width, height))
+
+    def agent(self, epoch: EpochView) -> ProtocolAgent:
+        """An auction agent bidding reward minus cost."""
+        return CbbaProtocol(
+            epoch.problem, epoch.robot, epoch.name, epoch.epoch, self.fleet.diameter, self.reward_m
+        )
+
+
+class Greedy(ProtocolBase):
+    """Nearest free task: each robot decides alone from the claims it has heard of."""
+
+    name: ClassVar[str] = "greedy"
+
+    def agent(self, epoch: EpochView) -> ProtocolAgent:
+        """The robot's nearest task that nobody else holds or claims."""
+        return GreedyProtocol(epoch.problem, epoch.robot, set(epoch.taken))
+
+
+class Hungarian(ProtocolBase):
+    """Centralized optimum on the base station (Hungarian method) from reported poses."""
+
+    name: ClassVar[str] = "hungarian"
+    central: ClassVar[bool] = True
+
+    def agent(self, epoch: EpochView) -> ProtocolAgent | None:
+        """None: orders come from the base station."""
+        return None
+
+    def orders(
+        self, tasks: Sequence[TaskInfo], poses: Mapping[str, tuple[float, float]]
+    ) -> dict[str, tuple[int, float]]:
+        """The optimum of straight-line costs among eligible pairs; -1 for robots left over."""
+        robots = list(poses)
+        if not robots or not tasks:
+            return {}
+        cost = np.full((len(robots), len(tasks)), np.inf)
+        for i, robot in enumerate(robots):
+            x, y = poses[robot]
+            for j, task in enumerate(tasks):
+                if robot in task.eligible:
+                    cost[i, j] = float(np.hypot(task.x_m - x, task.y_m - y))
+        problem = AssignmentProblem(tuple(robots), tuple(t.task_id for t in tasks), cost)
+        assignment, _ = hungarian(problem)
+        found = {}
+        for i, robot in enumerate(robots):
+            chosen = assignment.get(i)
+            found[robot] = (
+                (tasks[chosen].task_id, float(cost[i, chosen])) if chosen is not None else (-1, 0.0)
+            )
+        return found
+
+    def summary(self) -> Mapping[str, Any]:
+        """The base station's instance is solved to its optimum: no gap by construction."""
+        return {"optimality_gap": 0.0}

@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from adapters.assignment.protocols import AssignmentProtocol
+from adapters.assignment.contract import ProtocolAgent
 from cosim.core.recorder import Recorder
 from cosim.core.timebase import NS_PER_S
 from models.assignment.problem import AssignmentProblem, hungarian, objective
@@ -92,7 +92,7 @@ class DtaRecords:
         now_ns: int,
         robot: int,
         epoch: int,
-        protocol: AssignmentProtocol,
+        protocol: ProtocolAgent,
         changed: bool,
         nbytes: int,
     ) -> None:
@@ -113,7 +113,7 @@ class DtaRecords:
             bytes=record.nbytes.get(robot, 0) if record else 0,
         )
 
-    def decided(self, robot: int, epoch: int, now_ns: int, protocol: AssignmentProtocol) -> None:
+    def decided(self, robot: int, epoch: int, now_ns: int, protocol: ProtocolAgent) -> None:
         """A robot's protocol decided (or changed its decision) in ``epoch``."""
         record = self.epochs.get(epoch)
         if record is None:

@@ -45,12 +45,12 @@ from adapters.humans.files import (
     write_network,
 )
 from adapters.humans.session import Movers, SumoSession
+from adapters.humans.settings import HumansConfig
 from adapters.humans.tables import HumanRecords
 from cosim.core.adapter import RunContext
 from cosim.core.kernel import Stage
 from cosim.core.timebase import NS_PER_S, period_ns, s_to_ns
 from cosim.scenario.fields import model_problem
-from cosim.scenario.humans import HumansConfig
 from cosim.scenario.sections import RobotsConfig, ScenarioSection
 from models.arrays import FloatArray
 from models.errors import ModelError

@@ -12,10 +12,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from adapters.humans.settings import HumansConfig
 from adapters.tasks.source import TaskSourceAdapter
 from cosim.core.adapter import RunContext
 from cosim.core.timebase import NS_PER_S, period_ns
-from cosim.scenario.humans import HumansConfig
 from models.humans.encounters import HALT_MPS, Encounters
 from models.kinematics import FleetState
 from models.tasks.book import TaskStatus

@@ -26,9 +26,11 @@ from typing import Any, ClassVar
 import numpy as np
 
 from adapters.mapping.geometry import map_geometry
+from adapters.mapping.settings import MappingConfig
 from adapters.mapping.tables import MappingRecords
 from adapters.naming import topic
 from adapters.navigation.robots_layer import ROBOT_STATES
+from adapters.navigation.settings import NavigationConfig
 from cosim.core.adapter import RunContext
 from cosim.core.bus import Envelope, TopicQos
 from cosim.core.hosts import BASE_HOST, HostId
@@ -45,8 +47,7 @@ from cosim.core.messages import (
     Transform,
 )
 from cosim.core.timebase import period_ns, s_to_ns
-from cosim.scenario.mapping import MappingConfig
-from cosim.scenario.sections import LidarConfig, NavigationConfig, RobotsConfig
+from cosim.scenario.sections import LidarConfig, RobotsConfig
 from models.arrays import FloatArray
 from models.errors import ModelError
 from models.kinematics import FleetState

@@ -15,13 +15,13 @@ from __future__ import annotations
 import math
 
 from adapters.fleet.mirror import Mirrors
+from adapters.mocap.settings import MocapConfig
 from adapters.mocap.tables import MocapRecords
 from adapters.naming import topic
 from cosim.core.adapter import RunContext
 from cosim.core.hosts import HostId
 from cosim.core.messages import PoseStamped
 from cosim.core.timebase import NS_PER_S
-from cosim.scenario.mixed import MocapConfig
 from cosim.scenario.sections import RobotsConfig
 from models.kinematics import FleetState
 from models.mocap.gate import PoseGate

@@ -11,12 +11,12 @@ from __future__ import annotations
 from typing import Any, Protocol
 
 from adapters.mocap.feed import MotionCaptureFeed, mock_bodies
+from adapters.mocap.settings import MocapConfig
 from adapters.ros2dds.qos import QosKind
 from adapters.ros2dds.session import dds_session
 from adapters.ros2dds.types import PoseStamped as DdsPoseStamped
 from adapters.ros2dds.types import planar_pose
 from cosim.core.adapter import RunContext
-from cosim.scenario.mixed import MocapConfig
 from models.kinematics import FleetState
 
 Sample = tuple[int, int, float, float, float]

@@ -26,6 +26,7 @@ import simpy
 
 from adapters.mocap.intake import PoseIntake
 from adapters.mocap.live import LiveSource, open_live_source
+from adapters.mocap.settings import MocapConfig
 from adapters.mocap.tables import MocapRecords
 from adapters.mocap.tracking import external_bodies, simulated_robots
 from adapters.mocap.tracks import PoseTrack, read_pose_track
@@ -35,7 +36,6 @@ from cosim.core.hosts import HostKind
 from cosim.core.kernel import Stage
 from cosim.core.rng import BlockDraws
 from cosim.core.timebase import ms_to_ns, period_ns
-from cosim.scenario.mixed import MocapConfig
 from models.kinematics import FleetState
 from models.mocap.sampling import MocapParams, measure
 

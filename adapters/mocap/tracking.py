@@ -6,9 +6,10 @@ bridge, the robots' localization), so they cannot disagree.
 
 from __future__ import annotations
 
+from adapters.mocap.settings import MocapConfig
+from adapters.physical.settings import PhysicalConfig
 from cosim.core.adapter import ScenarioView
 from cosim.core.errors import ConfigError
-from cosim.scenario.mixed import MocapConfig, PhysicalConfig
 
 
 def _check_names(scenario: ScenarioView, names: list[str], robots: list[str], key: str) -> None:

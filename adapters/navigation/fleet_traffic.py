@@ -57,7 +57,6 @@ import numpy as np
 from adapters.navigation.places import (
     APPROACH,
     ARRIVE_M,
-    GAP_M,
     MOVE,
     RELEASE_M,
     SETTLE,
@@ -65,9 +64,7 @@ from adapters.navigation.places import (
     VIA_M,
     FleetPlaces,
 )
-from cosim.core.errors import ConfigError
 from cosim.core.timebase import s_to_ns
-from cosim.scenario.model import Scenario
 from models.arrays import BoolArray, FloatArray, IntArray
 from models.navigation.pibt import Pibt
 
@@ -75,45 +72,6 @@ URGENT_S = 10.0
 """A robot with no progress for this long goes first (s). Goals given up as above (with
 ``RELEASE_M`` 0.73, ``ARRIVE_M`` 0.3): 3 s 22, 6 s 14, 10 s 11, 20 s 41; the goal's age
 alone (PIBT's rule) 32; the time since progress alone 23."""
-
-
-def check_localization(scenario: Scenario, tracked: BoolArray) -> None:
-    """Refuse the fleet manager for robots that cannot tell where they are to within the gap.
-
-    The places are :data:`GAP_M` apart beyond the robots' bodies, and each robot drives to
-    them on its own pose estimate. Robots localizing on their own maps (``mapping.enabled``)
-    or on drifting odometry alone (``odometry.drift`` > 0) are off by more: in fleet50 the
-    maps put them 0.15-0.3 m off on average (50 robots mostly see each other), and with
-    traffic "pibt" robots touched 5 times in 2 seeds x 120 s (9 in 4 with drift 0.02)
-    where motion capture gave 0 contacts and 0 goals given up.
-
-    Args:
-        scenario: the run's scenario.
-        tracked: (n,) robots localizing by measured poses (motion capture).
-
-    Raises:
-        ConfigError: with traffic "pibt", when a robot not tracked localizes by mapping or
-            drifting odometry.
-    """
-    if scenario.navigation.traffic != "pibt" or tracked.all():
-        return
-    if scenario.mapping.enabled:
-        how = "[mapping] enabled = true (robots localize on their own maps, 0.15-0.3 m off)"
-    elif scenario.odometry.drift > 0:
-        how = (
-            f"[odometry] drift = {scenario.odometry.drift:g} (robots localize by odometry "
-            "alone, whose error grows without bound)"
-        )
-    else:
-        return
-    raise ConfigError(
-        f"{scenario.source}: [navigation] traffic = 'pibt' with {how}: expected every robot "
-        f"localized to within centimetres ({int((~tracked).sum())} of {len(tracked)} are not "
-        "tracked): the fleet manager keeps robots "
-        f"{GAP_M:g} m apart on neighbouring places and trusts their poses. Set "
-        "navigation.traffic = 'none' (each robot plans on what it knows) or track the robots "
-        "by motion capture (mocap.source = 'simulated')"
-    )
 
 
 class FleetTraffic:

@@ -18,13 +18,14 @@ import numpy as np
 from scipy import ndimage
 
 from adapters.naming import topic
+from adapters.navigation.settings import NavigationConfig
 from cosim.core.adapter import RunContext
 from cosim.core.bus import Envelope
 from cosim.core.errors import ConfigError
 from cosim.core.hosts import HostId
 from cosim.core.messages import Message, NavGoal, NavStatus
 from cosim.core.timebase import s_to_ns
-from cosim.scenario.sections import NavigationConfig, RobotsConfig, WorldConfig
+from cosim.scenario.sections import RobotsConfig, WorldConfig
 from models.kinematics import FleetState
 from models.navigation.costmap import StaticCostmap
 

@@ -15,10 +15,10 @@ import numpy as np
 import numpy.typing as npt
 
 from adapters.mapping.geometry import map_geometry, unknown_grid
+from adapters.mapping.settings import MappingConfig
+from adapters.navigation.settings import NavigationConfig
 from cosim.core.adapter import RunContext
 from cosim.core.messages import OccupancyGrid as GridMessage
-from cosim.scenario.mapping import MappingConfig
-from cosim.scenario.sections import NavigationConfig
 from models.navigation.costmap import CostmapParams, StaticCostmap
 from models.navigation.lanes import TWO_WAY, aisle_lanes
 from models.occupancy import (

@@ -1,94 +1,43 @@
-"""The local controller of every robot: a batched Dynamic Window Approach (Nav2's DWB role).
+"""The ``dwa`` local controller: a batched Dynamic Window Approach (Nav2's DWB role).
 
-Each control tick it turns every robot's carrot (the point of its global path a lookahead
-ahead) into a speed and a yaw rate, keeping clear of the lidar hits each robot remembers
-near it and of the other robots' discs it heard of; near things that move, speeds are
-capped (:func:`models.navigation.traffic.speed_caps`).
+Each control tick it turns every robot's carrot into a speed and a yaw rate by scoring
+sampled velocities over a short horizon against the lidar hits each robot remembers near it
+and the other robots' discs it heard of (:func:`models.navigation.dwa.dwa_batch`), all
+robots in one call.
 """
 
 from __future__ import annotations
 
-import numpy as np
+from typing import ClassVar
 
-from adapters.navigation.robots_layer import RobotsLayer
-from models.arrays import BoolArray, FloatArray, IntArray
-from models.kinematics import DriveLimits
+from adapters.navigation.contract import ControlInputs, ControllerContext
+from models.arrays import BoolArray, FloatArray
 from models.navigation.dwa import DwaParams, dwa_batch
-from models.navigation.traffic import MovingPoints, TrafficParams, speed_caps
 
 
 class DwaControl:
-    """DWA commands for the whole fleet at once.
+    """Dynamic Window Approach (Fox, Burgard, Thrun 1997) for the whole fleet at once."""
 
-    Args:
-        limits: the robots' drive limits.
-        radii_m: (n,) every robot's footprint radius (m).
-        radius_m: the fleet's footprint radius (m): how wide a robot ahead reaches.
-        control_hz: the control rate (Hz): the step DWA simulates.
-        robots_layer: the other robots' discs heard over the network, if used.
-        traffic: the traffic rules that cap speeds near moving things.
-    """
+    name: ClassVar[str] = "dwa"
 
-    def __init__(
-        self,
-        limits: DriveLimits,
-        radii_m: FloatArray,
-        radius_m: float,
-        control_hz: float,
-        robots_layer: RobotsLayer | None,
-        traffic: TrafficParams,
-    ) -> None:
-        self.limits = limits
-        self.radii_m = radii_m
-        self.radius_m = radius_m
-        self.params = DwaParams(control_period_s=1.0 / control_hz)
-        self.robots_layer = robots_layer
-        self.traffic = traffic
+    def __init__(self, context: ControllerContext) -> None:
+        self.limits = context.limits
+        self.radii_m = context.radii_m
+        self.params = DwaParams(control_period_s=1.0 / context.control_hz)
 
-    def commands(
-        self,
-        pose: FloatArray,
-        vel: FloatArray,
-        carrots: FloatArray,
-        goals: FloatArray,
-        points: FloatArray,
-        start: IntArray,
-        moving: MovingPoints,
-        now_ns: int,
-    ) -> tuple[FloatArray, FloatArray, BoolArray]:
-        """Speeds (m/s, capped near moving things), yaw rates (rad/s), and blocked robots.
-
-        Args:
-            pose: (n, 3) pose estimates in ``map`` (m, rad).
-            vel: (n, 2) measured speeds and yaw rates (m/s, rad/s).
-            carrots: (n, 2) the points to head for (m, ``map``).
-            goals: (n, 2) the goals (m, ``map``).
-            points: lidar hits near the robots (m, ``map``), robot ``i``'s at
-                ``points[start[i]:start[i + 1]]``.
-            start: (n + 1,) offsets into ``points``.
-            moving: the hits that belong to moving things.
-            now_ns: simulated time (ns): the age of what the robots layer heard.
-
-        Returns:
-            Speeds, yaw rates, and which robots found nothing admissible ahead.
-        """
-        n = len(pose)
-        if self.robots_layer is None:
-            discs, disc_start = np.zeros((0, 3)), np.zeros(n + 1, dtype=np.int64)
-        else:
-            discs, disc_start = self.robots_layer.all_discs(now_ns)
+    def commands(self, inputs: ControlInputs) -> tuple[FloatArray, FloatArray, BoolArray]:
+        """Speeds (m/s), yaw rates (rad/s), and the robots that found nothing admissible."""
         result = dwa_batch(
-            pose,
-            vel,
+            inputs.pose,
+            inputs.vel,
             self.limits,
             self.radii_m,
-            carrots,
-            goals,
-            points,
-            start,
-            discs,
-            disc_start,
+            inputs.carrots,
+            inputs.goals,
+            inputs.points,
+            inputs.start,
+            inputs.discs,
+            inputs.disc_start,
             self.params,
         )
-        caps = speed_caps(moving, n, self.radius_m, self.limits.max_speed_mps, self.traffic)
-        return np.minimum(result.v, caps), result.w, result.blocked
+        return result.v, result.w, result.blocked

@@ -19,6 +19,7 @@ import numpy as np
 import numpy.typing as npt
 
 from adapters.mocap.intake import pose_topic
+from adapters.mocap.settings import MocapConfig
 from adapters.mocap.tables import MocapRecords
 from adapters.mocap.tracking import tracked_robots
 from adapters.naming import topic
@@ -27,7 +28,6 @@ from cosim.core.bus import Envelope
 from cosim.core.hosts import HostId
 from cosim.core.messages import Message, Odometry, PoseStamped, TFMessage
 from cosim.core.timebase import NS_PER_S, ms_to_ns
-from cosim.scenario.mixed import MocapConfig
 from models.arrays import FloatArray
 from models.kinematics import FleetState
 from models.mapping.se2 import compose

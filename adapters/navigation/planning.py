@@ -1,12 +1,13 @@
-"""Global planning for every robot: A* on its own costmap, local repairs, when to replan.
+"""Global planning for every robot: when to plan, on what, and what to do with a path.
 
 Each robot plans on its costmap (:class:`~adapters.navigation.layers.StaticLayers`): the
 static layer plus the moving things it remembers and, with ``navigation.robots_layer``, the
-other robots' discs heard over the network. A replan first repairs the stretch ahead in a
-window (:mod:`models.navigation.repair`) and plans in full when that finds nothing or a
-much longer way; if nothing is found with what the robot sees, it plans on the static layer
-alone, as Nav2's "clear costmap" recovery does. Periodic replans (``replan_hz``) happen only
-when something moving is on the path ahead or round the last plan.
+other robots' discs heard over the network; the global planner (``navigation.planner``, A*
+by default) finds the path. A replan first asks the planner to repair the stretch ahead and
+plans in full when that finds nothing or a much longer way; if nothing is found with what
+the robot sees, it plans on the static layer alone, as Nav2's "clear costmap" recovery
+does. Periodic replans (``replan_hz``) happen only when something moving is on the path
+ahead or round the last plan.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import time
 
 import numpy as np
 
+from adapters.navigation.contract import GlobalPlanner, PlanRequest, RepairRequest
 from adapters.navigation.layers import StaticLayers
 from adapters.navigation.robots_layer import RobotsLayer
 from adapters.navigation.scan_memory import MovingMemory, ScanMemory
@@ -29,16 +31,13 @@ from models.navigation.costmap import StaticCostmap, with_obstacles
 from models.navigation.follow import PathBook, paths_blocked
 from models.navigation.landmarks import ALT_MIN_CELLS, LandmarkCache
 from models.navigation.lanes import in_lanes
-from models.navigation.planner import path_to_world, plan, prune_path, shortest_path_length_m
-from models.navigation.repair import RepairParams, repair_path
+from models.navigation.planner import shortest_path_length_m
 from models.navigation.traffic import MovingPoints
 
 PATH_CLEARANCE_M = 0.3
 """A moving thing closer than footprint plus this to the path ahead calls for a replan (m)."""
 REPAIR_DETOUR_M = 2.0
 """A repair lengthening the way by more than this is checked against a full replan (m)."""
-LANE_AGAINST = 5.0
-"""``traffic = "lanes"``: a step against an aisle's direction costs this many times more."""
 Found = tuple[tuple[np.ndarray, float] | None, str, np.ndarray]
 """A plan's outcome: the route ``(waypoints, length_m)`` or None, how it was found, and the
 moving things planned round."""
@@ -48,6 +47,7 @@ class GlobalPlanning:
     """Plans, repairs and replans of every robot's global path.
 
     Args:
+        planner: the global planner.
         static: the static layer every robot shares (the building's map).
         layers: each robot's static layer (the shared one, or the map it builds).
         lanes: one-way lanes on the layers' cells (``traffic = "lanes"``), or None.
@@ -70,6 +70,7 @@ class GlobalPlanning:
     def __init__(
         self,
         *,
+        planner: GlobalPlanner,
         static: StaticCostmap,
         layers: StaticLayers,
         lanes: np.ndarray | None,
@@ -87,6 +88,7 @@ class GlobalPlanning:
         hosts: list[HostId],
         plan_topics: list[str],
     ) -> None:
+        self.planner = planner
         self.static = static
         self.layers = layers
         self.lanes = lanes
@@ -103,12 +105,11 @@ class GlobalPlanning:
         self.records = records
         self.hosts = hosts
         self.plan_topics = plan_topics
-        self.repair = RepairParams()
         n = len(pose)
         self.planned_around = np.zeros(n, dtype=bool)
         self.next_plan_ns = np.zeros(n, dtype=np.int64)
-        # A*'s landmark bounds on the shared static layer, built on first use, on floors
-        # large enough for the fleet's plans to pay for them (see _full for where they hold)
+        # landmark bounds for the yardstick's searches on the building's map, built on first
+        # use, on floors large enough for them to pay
         self.landmarks = LandmarkCache(static) if static.cost.size >= ALT_MIN_CELLS else None
 
     def yardstick(self, start: FloatArray, goal: FloatArray) -> float:
@@ -207,44 +208,25 @@ class GlobalPlanning:
     def _repair(
         self, i: int, layer: StaticCostmap, points: np.ndarray, discs: np.ndarray
     ) -> tuple[np.ndarray, float] | None:
-        """The path with its stretch ahead replanned in a window, or None."""
-        repaired = repair_path(
+        """The path with its stretch ahead replanned, or None."""
+        request = RepairRequest(
             layer,
             points,
             discs if len(discs) else None,
             self.paths.waypoints(i),
             int(self.paths.segment[i]),
             self.pose[i, :2],
-            self.repair,
-            lanes=self.lanes,
-            against=LANE_AGAINST,
+            self.lanes,
         )
-        return None if repaired is None else (repaired.waypoints, repaired.length_m)
+        return self.planner.repair(request)
 
     def _full(
         self, i: int, layer: StaticCostmap, points: np.ndarray, discs: np.ndarray
     ) -> tuple[np.ndarray, float] | None:
         """A path from the robot to its goal over the whole map, or None."""
         cost = with_obstacles(layer, points, discs=discs if len(discs) else None)
-        s_cell = layer.world_to_cell(self.pose[i, :2])
-        g_cell = layer.world_to_cell(self.goal[i])
-        marks = None
-        if self.landmarks is not None and layer is self.static:
-            marks = self.landmarks.get(1.0)  # not on a map the robot builds: other costs
-        result = plan(
-            cost,
-            s_cell,
-            g_cell,
-            resolution_m=layer.resolution_m,
-            lanes=self.lanes,
-            against=LANE_AGAINST,
-            landmarks=marks,
-        )
-        if not result.found:
-            return None
-        waypoints = path_to_world(layer, prune_path(cost, result.cells))
-        waypoints[-1] = self.goal[i]
-        return waypoints, result.length_m
+        request = PlanRequest(layer, cost, self.pose[i, :2], self.goal[i], self.lanes)
+        return self.planner.plan(request)
 
     def _set_path(
         self,

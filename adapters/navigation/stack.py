@@ -25,18 +25,26 @@ from typing import Any, ClassVar
 import numpy as np
 
 from adapters.fleet.motion import drive_limits
-from adapters.mocap.tracking import tracked_robots
-from adapters.naming import robot_name, topic
-from adapters.navigation.fleet_traffic import FleetTraffic, check_localization
+from adapters.mapping.settings import MappingConfig
+from adapters.naming import topic
+from adapters.navigation.contract import (
+    ControlInputs,
+    ControllerContext,
+    PlannerContext,
+    TrafficContext,
+    controller_registry,
+    planner_registry,
+    traffic_registry,
+)
+from adapters.navigation.fleet_traffic import FleetTraffic
 from adapters.navigation.goal_tracking import Drivers, GoalTracker
-from adapters.navigation.layers import lanes_on, robot_layers, static_costmap
-from adapters.navigation.local_control import DwaControl
+from adapters.navigation.layers import robot_layers, static_costmap
 from adapters.navigation.localization import Localization
-from adapters.navigation.places import FleetPlaces
 from adapters.navigation.planning import GlobalPlanning
 from adapters.navigation.recovery import Recovery, StallWatch
 from adapters.navigation.robots_layer import RobotsLayer
 from adapters.navigation.scan_memory import MovingMemory, ScanMemory
+from adapters.navigation.settings import NavigationConfig
 from adapters.navigation.tables import NavRecords
 from cosim.core.adapter import RunContext
 from cosim.core.bus import Envelope
@@ -53,17 +61,20 @@ from cosim.core.messages import (
 )
 from cosim.core.messages import OccupancyGrid as GridMessage
 from cosim.core.timebase import NS_PER_S, period_ns, s_to_ns
-from cosim.scenario.mapping import MappingConfig
 from cosim.scenario.model import Scenario
-from cosim.scenario.sections import LidarConfig, NavigationConfig, RobotsConfig
+from cosim.scenario.sections import LidarConfig, RobotsConfig
 from models.kinematics import FleetState
 from models.lidar import ScanGeometry
 from models.navigation.dwa import DwaParams
 from models.navigation.follow import PathBook
 from models.navigation.place_drive import free_ahead
-from models.navigation.traffic import MovingPoints, TrafficParams, keep_right, moving_points
-from models.occupancy import ground_truth_grid
-from models.world import Warehouse
+from models.navigation.traffic import (
+    MovingPoints,
+    TrafficParams,
+    keep_right,
+    moving_points,
+    speed_caps,
+)
 
 HALT_MPS = 0.02
 """Commanded speed below which a robot with a goal counts as halted (m/s)..."""
@@ -82,13 +93,17 @@ class NavigationAdapter:
 
     @staticmethod
     def check_scenario(scenario: Scenario) -> None:
-        """Refuse the fleet manager for robots that cannot localize well enough for it.
+        """Names known, and what the chosen traffic policy refuses (before anything is built).
 
-        See :func:`~adapters.navigation.fleet_traffic.check_localization`.
+        A policy may declare ``check_scenario(scenario)``: the fleet manager refuses robots
+        that cannot localize well enough for its places.
         """
-        names = [robot_name(i) for i in range(scenario.robots.count)]
-        tracked = np.isin(names, tracked_robots(scenario, names))
-        check_localization(scenario, tracked)
+        cfg = scenario.section(NavigationConfig)
+        controller_registry().get(cfg.controller)
+        planner_registry().get(cfg.planner)
+        check = getattr(traffic_registry().get(cfg.traffic), "check_scenario", None)
+        if check is not None:
+            check(scenario)
 
     def __init__(self, run: RunContext) -> None:
         cfg = run.settings(NavigationConfig)
@@ -106,32 +121,23 @@ class NavigationAdapter:
         self.static = static_costmap(run, radius)
         self.mapping = run.settings(MappingConfig).enabled
         self.layers = robot_layers(run, self.static, n)
-        if cfg.traffic in ("lanes", "pibt"):
-            truth = ground_truth_grid(run.service(Warehouse), cfg.resolution_m)
-        self.lanes: np.ndarray | None = None
-        if cfg.traffic == "lanes":
-            # drawn on the building's map by the fleet manager, as Open-RMF's lanes are
-            self.lanes = lanes_on(self.layers[0], truth, LANE_WIDTH_M)
-        self.manager: FleetTraffic | None = None
-        if cfg.traffic == "pibt":  # the fleet manager moves every robot place by place
-            places = FleetPlaces(
-                self.static,
-                lanes_on(self.static, truth, LANE_WIDTH_M),
-                np.stack([self.fleet.x, self.fleet.y], axis=1),
-                radius,
-            )
-            self.manager = FleetTraffic(places)
+        starts = np.stack([self.fleet.x, self.fleet.y], axis=1)
+        traffic = traffic_registry().get(cfg.traffic)(
+            TrafficContext(run, self.static, self.layers, starts, radius, cfg.resolution_m)
+        )
+        self.lanes = traffic.lanes
+        self.manager = traffic.manager  # a fleet manager moves the robots itself, or None
         run.provide(self.static)
         self.localization = Localization(run, self.fleet, mapping=self.mapping)
         self.measured = self.localization.measured
         self.limits = drive_limits(run)
-        self.dwa = DwaParams(control_period_s=1.0 / cfg.control_hz)
         self.period_ns = period_ns(cfg.control_hz)
         lidar = run.settings(LidarConfig)
         angles = _beam_angles(lidar.beams, math.radians(lidar.fov_deg))
         self.memory = ScanMemory(n, angles, lidar.range_max_m)
         self.moving = MovingMemory(s_to_ns(cfg.obstacle_memory_s), self.layers.resolution_m)
-        self.near_m = self.limits.max_speed_mps * self.dwa.sim_time_s + radius + 1.0
+        # lidar hits within what a robot can drive in a DWA horizon (plus a margin) matter
+        self.near_m = self.limits.max_speed_mps * DwaParams().sim_time_s + radius + 1.0
         self.paths = PathBook(n)
         self.pose = self.localization.pose
         self.vel = self.localization.vel
@@ -143,13 +149,9 @@ class NavigationAdapter:
         self.records = NavRecords(run.recorder, self.names)
         self.rngs = [run.rng.stream(f"navigation/{name}") for name in self.names]
         self.traffic = TrafficParams()
-        self.control = DwaControl(
-            self.limits,
-            self.fleet.radius_m,
-            radius,
-            cfg.control_hz,
-            self.robots_layer,
-            self.traffic,
+        self.radius = radius
+        self.control = controller_registry().get(cfg.controller)(
+            ControllerContext(run, self.limits, self.fleet.radius_m, cfg.control_hz)
         )
         self.recovery = Recovery(n, self.memory, self.limits, radius, self.rngs)
         self.stalls = StallWatch(self.pose)
@@ -175,7 +177,9 @@ class NavigationAdapter:
             bus.advertise(path, Path)
         if self.robots_layer is not None:
             self.robots_layer.advertise(run)
+        planner = planner_registry().get(cfg.planner)(PlannerContext(run, self.static))
         self.planning = GlobalPlanning(
+            planner=planner,
             static=self.static,
             layers=self.layers,
             lanes=self.lanes,
@@ -273,9 +277,7 @@ class NavigationAdapter:
             self.pose[:, 0], self.pose[:, 1], self.cfg.lookahead_m
         )
         carrots = keep_right(carrots, moving, self.pose, active, self.traffic)
-        v, w, blocked = self.control.commands(
-            self.pose, self.vel, carrots, goal, points, start, moving, now_ns
-        )
+        v, w, blocked = self._local_control(carrots, goal, points, start, moving, now_ns)
         moving_ok = active & ~lost
         v = np.where(moving_ok, v, 0.0)
         w_cmd = np.where(moving_ok, w, 0.0)
@@ -318,14 +320,35 @@ class NavigationAdapter:
         # the local controller only for robots settling onto a place from off it
         settle = None
         if places.settling.any():
-            settle = self.control.commands(
-                self.pose, self.vel, aims, aims, points, start, moving, now_ns
-            )
+            settle = self._local_control(aims, aims, points, start, moving, now_ns)
         free = free_ahead(points, start, self.pose, places.radius_m)
         v, w = places.commands(self.pose, aims, settle, free, self.limits)
         goals.track(run, now_ns, remaining)
         goals.remaining = remaining
         self._publish(run, np.where(lost, 0.0, v), np.where(lost, 0.0, w))
+
+    def _local_control(
+        self,
+        carrots: np.ndarray,
+        goals: np.ndarray,
+        points: np.ndarray,
+        start: np.ndarray,
+        moving: MovingPoints,
+        now_ns: int,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The local controller's commands, speeds capped near moving things."""
+        if self.robots_layer is None:
+            discs, disc_start = np.zeros((0, 3)), np.zeros(len(self.names) + 1, dtype=np.int64)
+        else:
+            discs, disc_start = self.robots_layer.all_discs(now_ns)
+        inputs = ControlInputs(
+            self.pose, self.vel, carrots, goals, points, start, moving, discs, disc_start, now_ns
+        )
+        v, w, blocked = self.control.commands(inputs)
+        caps = speed_caps(
+            moving, len(self.names), self.radius, self.limits.max_speed_mps, self.traffic
+        )
+        return np.minimum(v, caps), w, blocked
 
     def _publish(self, run: RunContext, v: np.ndarray, w: np.ndarray) -> None:
         commands = [Twist(vi, wi) for vi, wi in zip(v.tolist(), w.tolist(), strict=True)]

@@ -17,6 +17,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from adapters.network.settings import NetworkConfig
 from adapters.network.setup import build_model, build_topology, partitions_of
 from cosim.core.adapter import RunContext
 from cosim.core.errors import ConfigError
@@ -24,7 +25,6 @@ from cosim.core.hosts import HostId, HostKind
 from cosim.core.kernel import Stage
 from cosim.core.link import AllDelivered, DeliveryStatus, Transfer
 from cosim.core.timebase import NS_PER_S, period_ns
-from cosim.scenario.network import NetworkConfig
 from models.kinematics import FleetState
 from models.network.fate import Fate
 from models.network.model import NetworkModel, Partition

@@ -5,10 +5,10 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import TypeVar
 
+from adapters.network.settings import NetworkConfig
 from cosim.core.adapter import RunContext
 from cosim.core.timebase import s_to_ns
 from cosim.scenario.fields import model_problem
-from cosim.scenario.network import NetworkConfig
 from models.errors import ModelError
 from models.network.latency import (
     ConstantLatency,

@@ -27,6 +27,7 @@ from typing import Any, ClassVar
 from adapters.mocap.intake import PoseIntake
 from adapters.mocap.tracking import physical_robots
 from adapters.naming import topic
+from adapters.physical.settings import PhysicalConfig
 from adapters.ros2dds import types as dds
 from adapters.ros2dds.participant import Publisher, Subscription
 from adapters.ros2dds.qos import QosKind
@@ -38,7 +39,6 @@ from cosim.core.kernel import Stage
 from cosim.core.messages import LaserScan, Message, PoseStamped, Twist
 from cosim.core.messages.navigation import NavGoal
 from cosim.core.timebase import period_ns
-from cosim.scenario.mixed import PhysicalConfig
 from models.kinematics import FleetState
 
 

@@ -6,9 +6,9 @@ Shared by the physical-robot bridge and a ``ros2`` mocap source, opened on first
 
 from __future__ import annotations
 
+from adapters.physical.settings import PhysicalConfig
 from adapters.ros2dds.participant import RosParticipant
 from cosim.core.adapter import RunContext
-from cosim.scenario.mixed import PhysicalConfig
 
 
 class DdsSession:

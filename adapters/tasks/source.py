@@ -5,9 +5,10 @@ whenever one is completed (as in the paper), up to ``tasks.max_total``. The open
 are broadcast as a :class:`~cosim.core.messages.TaskSet` over the network whenever they change
 (a new *epoch*) and every ``assignment.rebroadcast_s``. It keeps the book of claims and is
 the one authority on service: a robot at a task asks for the right to serve it, and only
-one robot ever gets it (see :mod:`models.tasks.book`). With ``assignment.protocol =
-"hungarian"`` it also solves the assignment centrally from the robots' reported poses and
-sends each robot its order over the network.
+one robot ever gets it (see :mod:`models.tasks.book`). With a central protocol (one whose
+``central`` is true, such as ``hungarian``) it also asks the protocol, at every
+announcement, for the free robots' tasks from their reported poses and sends each robot its
+order over the network.
 """
 
 from __future__ import annotations
@@ -18,6 +19,12 @@ from typing import Any, ClassVar
 import numpy as np
 from scipy import ndimage
 
+from adapters.assignment.contract import (
+    AssignmentProtocolType,
+    ProtocolInUse,
+    protocol_registry,
+)
+from adapters.assignment.settings import AssignmentConfig
 from adapters.assignment.topics import (
     CLAIMS,
     DONE,
@@ -28,6 +35,7 @@ from adapters.assignment.topics import (
     order_topic,
     reply_topic,
 )
+from adapters.tasks.settings import TasksConfig
 from cosim.core.adapter import RunContext
 from cosim.core.bus import Envelope
 from cosim.core.errors import ScenarioError
@@ -45,8 +53,7 @@ from cosim.core.messages import (
     TaskSet,
 )
 from cosim.core.timebase import NS_PER_S, period_ns, s_to_ns
-from cosim.scenario.sections import AssignmentConfig, RobotsConfig, TasksConfig, WorldConfig
-from models.assignment.problem import AssignmentProblem, hungarian
+from cosim.scenario.sections import RobotsConfig, WorldConfig
 from models.kinematics import FleetState
 from models.navigation.costmap import INSCRIBED, StaticCostmap
 from models.tasks.book import ClaimOutcome, TaskBook, TaskStatus
@@ -69,7 +76,7 @@ ANNOUNCE_HZ = 5.0
 
 
 class TaskSourceAdapter:
-    """Creates, announces and closes tasks; grants service; the Hungarian baseline."""
+    """Creates, announces and closes tasks; grants service; orders of a central protocol."""
 
     name: ClassVar[str] = "task_source"
     requires: ClassVar[tuple[str, ...]] = ("world", "fleet", "network", "navigation")
@@ -87,6 +94,7 @@ class TaskSourceAdapter:
                 f"{run.settings(WorldConfig).shelf_count}: "
                 "expected shelves with a reachable pick station (tasks are served at shelves)"
             )
+        self.central = protocol_registry().get(self.assignment.protocol).central
         self.rng = run.rng.stream("tasks")
         self.book = TaskBook(
             self.robots, s_to_ns(self.assignment.claim_timeout_s), self.assignment.preemption
@@ -96,13 +104,14 @@ class TaskSourceAdapter:
         self.dirty = True
         self.last_announce_ns = -(1 << 62)
         self.poses: dict[str, tuple[float, float]] = {}
+        self.protocol: AssignmentProtocolType | None = None
         self.orders: dict[str, tuple[int, float]] = {}
         run.provide(self)
         run.bus.advertise(TASKS, TaskSet)
         for robot in self.robots:
             run.bus.advertise(reply_topic(robot), ServiceReply)
             run.bus.advertise(ack_topic(robot), TaskDone)
-            if self.assignment.protocol == "hungarian":
+            if self.central:
                 run.bus.advertise(order_topic(robot), TaskOrder)
 
     # -- life of tasks ---------------------------------------------------------------
@@ -112,7 +121,8 @@ class TaskSourceAdapter:
         bus.subscribe(CLAIMS, BASE_HOST, self._handler(run, self._on_claim))
         bus.subscribe(SERVICE_REQUESTS, BASE_HOST, self._handler(run, self._on_request))
         bus.subscribe(DONE, BASE_HOST, self._handler(run, self._on_done))
-        if self.assignment.protocol == "hungarian":
+        self.protocol = run.service(ProtocolInUse).protocol if self.central else None
+        if self.central:
             bus.subscribe(REPORTS, BASE_HOST, self._handler(run, self._on_report))
         for _ in range(self.cfg.initial):
             self._create(run)
@@ -165,9 +175,9 @@ class TaskSourceAdapter:
         if self.dirty:
             self.epoch += 1
             self.dirty = False
-        if self.assignment.protocol == "hungarian":
+        if self.protocol is not None:
             # re-solved at every announcement: robot poses arrive over time
-            self._solve_centrally(run)
+            self._solve_centrally(self.protocol)
         self.last_announce_ns = now_ns
         tasks = tuple(
             TaskInfo(
@@ -225,29 +235,19 @@ class TaskSourceAdapter:
     def _on_report(self, run: RunContext, state: RobotState) -> None:
         self.poses[state.robot] = (state.x_m, state.y_m)
 
-    # -- the centralized baseline -----------------------------------------------------------
-    def _solve_centrally(self, run: RunContext) -> None:
-        """Hungarian optimum over the robots whose pose the base knows and are free."""
+    # -- a central protocol ------------------------------------------------------------------
+    def _solve_centrally(self, protocol: AssignmentProtocolType) -> None:
+        """The protocol's orders for the robots whose pose the base knows and are free."""
         held = {t.task_id: self.book.holder(t) for t in self.book.offered()}
-        tasks = [t for t in self.book.offered() if not held[t.task_id]]
+        tasks = [
+            TaskInfo(t.task_id, t.x_m, t.y_m, tuple(sorted(t.eligible, key=self.robots.index)), "")
+            for t in self.book.offered()
+            if not held[t.task_id]
+        ]
         busy = {holder for holder in held.values() if holder}
-        robots = [r for r in self.robots if r in self.poses and r not in busy]
+        poses = {r: self.poses[r] for r in self.robots if r in self.poses and r not in busy}
         self.orders = {r: order for r, order in self.orders.items() if r in busy}
-        if not robots or not tasks:
-            return
-        cost = np.full((len(robots), len(tasks)), np.inf)
-        for i, robot in enumerate(robots):
-            x, y = self.poses[robot]
-            for j, task in enumerate(tasks):
-                if robot in task.eligible:
-                    cost[i, j] = float(np.hypot(task.x_m - x, task.y_m - y))
-        problem = AssignmentProblem(tuple(robots), tuple(t.task_id for t in tasks), cost)
-        assignment, _ = hungarian(problem)
-        for i, robot in enumerate(robots):
-            chosen = assignment.get(i)
-            self.orders[robot] = (
-                (tasks[chosen].task_id, float(cost[i, chosen])) if chosen is not None else (-1, 0.0)
-            )
+        self.orders.update(protocol.orders(tasks, poses))
 
     # -- records ---------------------------------------------------------------------------
     def finish(self, run: RunContext) -> Mapping[str, Any]:

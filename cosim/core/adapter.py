@@ -153,3 +153,21 @@ class AdapterType(Protocol):
     def __call__(self, run: RunContext) -> Adapter:
         """Construct the adapter; may :meth:`RunContext.provide` services."""
         ...
+
+
+@dataclass(frozen=True)
+class Driver:
+    """Robot software: the adapters that make up a ``robots.driver``.
+
+    Drivers are registered in the ``cosim.drivers`` entry-point group; the entry point
+    names a ``Driver`` object.
+
+    Attributes:
+        adapters: the adapters to run (their requirements are added).
+        summary: one line saying what the robots do.
+        needs_lidar: the software avoids what the lidar sees (refused with no beams).
+    """
+
+    adapters: tuple[str, ...]
+    summary: str
+    needs_lidar: bool = True

@@ -1,83 +1,262 @@
-"""The adapter registry, filled from the ``cosim.adapters`` entry-point group.
+"""Registries of pluggable implementations, filled from entry-point groups.
 
-A third party adds an adapter by installing a package that declares, in its
-``pyproject.toml``::
+Every choice a scenario makes between implementations is a registry, and cosim's own
+implementations register exactly as a third party's do: in its ``pyproject.toml``::
 
-    [project.entry-points."cosim.adapters"]
-    my_sensor = "my_package.adapter:MySensorAdapter"
+    [project.entry-points."cosim.protocols"]
+    my_auction = "my_package.auction:MyAuction"
 
-An unknown name is an error that suggests the nearest registered names.
+The groups are :data:`GROUPS`: adapters, settings sections, robot drivers, assignment
+protocols, local controllers, global planners and traffic policies. A registry reads the
+names of its group from the installed packages' metadata and imports an entry only when it
+is asked for, so a broken plugin is named when, and only when, a run uses it. An unknown
+name is refused with the registered names and the nearest ones.
 """
 
 from __future__ import annotations
 
 import difflib
-from collections.abc import Iterable, Mapping
-from importlib.metadata import entry_points
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass
+from functools import cache
+from importlib.metadata import EntryPoint, entry_points
+from typing import Any, Generic, TypeVar
 
-from cosim.core.adapter import AdapterType
 from cosim.core.errors import RegistryError
 
-GROUP = "cosim.adapters"
+T = TypeVar("T")
+
+GROUPS: dict[str, str] = {
+    "adapter": "cosim.adapters",
+    "section": "cosim.sections",
+    "driver": "cosim.drivers",
+    "protocol": "cosim.protocols",
+    "controller": "cosim.controllers",
+    "planner": "cosim.planners",
+    "traffic": "cosim.traffic",
+}
+"""Registry kind -> entry-point group."""
+
+KIND_WORDS: dict[str, str] = {
+    "adapter": "adapter",
+    "section": "settings section",
+    "driver": "robot driver",
+    "protocol": "assignment protocol",
+    "controller": "local controller",
+    "planner": "global planner",
+    "traffic": "traffic policy",
+}
+"""How messages name an entry of each kind."""
+
+NAMED = frozenset({"adapter", "protocol", "controller", "planner", "traffic"})
+"""Kinds whose entries declare their own ``name`` (it must match the entry point's)."""
+
+Check = Callable[[str, Any], str | None]
+"""A contract check: (name, loaded object) -> what is wrong, or None."""
 
 
-class AdapterRegistry:
-    """Adapter types by registered name.
+@dataclass(frozen=True)
+class Plugin:
+    """One registered entry, as ``cosim plugins`` lists it.
 
-    Args:
-        entries: name -> adapter type.
+    Attributes:
+        kind: the registry kind (``adapter``, ``protocol``, ...).
+        name: the registered name.
+        package: the distribution that registers it (``cosim`` for the built-ins).
+        target: ``module:attribute`` of the entry point.
+        summary: the first line of its docstring.
+        error: why it cannot be loaded, or None.
     """
 
-    def __init__(self, entries: Mapping[str, AdapterType]) -> None:
-        self._entries = dict(entries)
+    kind: str
+    name: str
+    package: str
+    target: str
+    summary: str
+    error: str | None = None
+
+
+class Registry(Generic[T]):
+    """The entries of one kind, by registered name, imported on first use.
+
+    Args:
+        kind: the registry kind (a key of :data:`GROUPS`).
+        entries: name -> entry point (imported when asked for) or the object itself.
+        check: a contract check run once on every loaded entry.
+    """
+
+    def __init__(
+        self,
+        kind: str,
+        entries: Mapping[str, EntryPoint | T],
+        check: Check | None = None,
+    ) -> None:
+        self.kind = kind
+        self._entries: dict[str, EntryPoint | T] = dict(entries)
+        self._loaded: dict[str, T] = {}
+        self._check = check
+
+    @classmethod
+    def installed(cls, kind: str, check: Check | None = None) -> Registry[Any]:
+        """The entries of ``kind`` that installed packages declare (names only, no import).
+
+        Entries of cosim itself come first, in declaration order; then other packages' by
+        package name.
+        """
+        return Registry(kind, _entry_points(GROUPS[kind]), check)
+
+    @property
+    def words(self) -> str:
+        """How messages name an entry of this kind (``assignment protocol``)."""
+        return KIND_WORDS.get(self.kind, self.kind)
+
+    def names(self) -> list[str]:
+        """Registered names, in registry order."""
+        return list(self._entries)
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._entries
+
+    def with_entry(self, name: str, entry: T) -> Registry[T]:
+        """A copy with ``entry`` registered as ``name`` (for tests and ``cosim.run``)."""
+        copy = Registry(self.kind, {**self._entries, name: entry}, self._check)
+        copy._loaded = {k: v for k, v in self._loaded.items() if k != name}
+        return copy
+
+    def package(self, name: str) -> str:
+        """The distribution that registers ``name`` (``cosim`` for the built-ins)."""
+        entry = self._entries.get(name)
+        if isinstance(entry, EntryPoint):
+            return entry.dist.name if entry.dist is not None else "?"
+        return "(given in code)"
+
+    def target(self, name: str) -> str:
+        """Where ``name`` comes from: ``module:attribute``."""
+        entry = self._entries[name]
+        if isinstance(entry, EntryPoint):
+            return entry.value
+        return f"{getattr(entry, '__module__', '?')}:{getattr(entry, '__qualname__', '?')}"
+
+    def unknown(self, name: str) -> RegistryError:
+        """The error for a name that is not registered: the registered names, the nearest."""
+        return RegistryError(f"unknown {self.words} {name!r}" + suggest_names(name, self.names()))
+
+    def get(self, name: str) -> T:
+        """The entry registered as ``name``, imported and checked on first use.
+
+        Raises:
+            RegistryError: for an unknown name (with the nearest ones), or an entry that
+                cannot be imported or breaks its kind's contract (naming the plugin).
+        """
+        found = self._loaded.get(name)
+        if found is not None:
+            return found
+        entry = self._entries.get(name)
+        if entry is None:
+            raise self.unknown(name)
+        where = f"{self.words} {name!r} ({self.target(name)}, package {self.package(name)})"
+        loaded: Any = entry
+        if isinstance(entry, EntryPoint):
+            try:
+                loaded = entry.load()
+            except Exception as error:  # a broken plugin must name itself
+                raise RegistryError(
+                    f"{where} cannot be loaded: {type(error).__name__}: {error}"
+                ) from error
+        declared = getattr(loaded, "name", name) if self.kind in NAMED else name
+        if declared != name:
+            raise RegistryError(f"{where} declares name = {declared!r}; expected {name!r}")
+        problem = self._check(name, loaded) if self._check is not None else None
+        if problem is not None:
+            raise RegistryError(f"{where}: {problem}")
+        self._loaded[name] = loaded
+        return loaded  # type: ignore[no-any-return]
+
+    def load_all(self) -> dict[str, T]:
+        """Every entry that loads, by name; broken ones are left out (see :meth:`describe`)."""
+        loaded: dict[str, T] = {}
+        for name in self.names():
+            try:
+                loaded[name] = self.get(name)
+            except RegistryError:
+                continue
+        return loaded
+
+    def describe(self) -> list[Plugin]:
+        """Every entry with its package and one-line summary; broken ones with their error."""
+        plugins = []
+        for name in self.names():
+            try:
+                loaded = self.get(name)
+            except RegistryError as error:
+                plugins.append(
+                    Plugin(self.kind, name, self.package(name), self.target(name), "", str(error))
+                )
+                continue
+            declared = getattr(loaded, "summary", None)
+            doc = declared if isinstance(declared, str) else (loaded.__doc__ or "").strip()
+            summary = doc.splitlines()[0] if doc else ""
+            plugins.append(Plugin(self.kind, name, self.package(name), self.target(name), summary))
+        return plugins
+
+
+def suggest_names(name: str, names: Iterable[str]) -> str:
+    """``; did you mean 'x'? (registered: a, b, c)`` for an unknown ``name``."""
+    options = list(names)
+    close = difflib.get_close_matches(name, options, n=3, cutoff=0.5)
+    hint = f"; did you mean {', '.join(repr(c) for c in close)}?" if close else ""
+    return f"{hint} (registered: {', '.join(options) or 'none'})"
+
+
+@cache
+def _entry_points(group: str) -> dict[str, EntryPoint]:
+    """A group's entry points, cosim's first in declaration order, then by package name."""
+    found = list(entry_points(group=group))
+
+    def package(point: EntryPoint) -> str:
+        return point.dist.name if point.dist is not None else ""
+
+    ours = [p for p in found if package(p) == "cosim"]
+    theirs = sorted((p for p in found if package(p) != "cosim"), key=lambda p: package(p))
+    entries: dict[str, EntryPoint] = {}
+    for point in ours + theirs:
+        entries.setdefault(point.name, point)  # the first package to claim a name keeps it
+    return entries
+
+
+def _adapter_contract(name: str, loaded: Any) -> str | None:
+    """What an adapter type lacks: ``requires``, a constructor, ``start`` and ``finish``."""
+    if not callable(loaded):
+        return "is not a class (expected a class constructed with the run)"
+    requires = getattr(loaded, "requires", None)
+    if not isinstance(requires, tuple) or not all(isinstance(r, str) for r in requires):
+        return f"requires = {requires!r}; expected a tuple of adapter names"
+    for method in ("start", "finish"):
+        if not callable(getattr(loaded, method, None)):
+            return f"has no {method}(run) method (see cosim.core.adapter.Adapter)"
+    return None
+
+
+class AdapterRegistry(Registry[Any]):
+    """Adapter types by registered name, with their requirements resolved.
+
+    Args:
+        entries: name -> adapter type, or entry point.
+    """
+
+    def __init__(self, entries: Mapping[str, Any]) -> None:
+        super().__init__("adapter", entries, _adapter_contract)
 
     @classmethod
     def from_entry_points(cls) -> AdapterRegistry:
-        """Load every adapter declared in the ``cosim.adapters`` entry-point group.
+        """Every adapter that installed packages declare in ``cosim.adapters`` (not imported)."""
+        return cls(_entry_points(GROUPS["adapter"]))
 
-        Raises:
-            RegistryError: if an entry point cannot be imported or its class declares
-                another name than the entry point.
-        """
-        entries: dict[str, AdapterType] = {}
-        for point in sorted(entry_points(group=GROUP), key=lambda p: p.name):
-            try:
-                loaded = point.load()
-            except Exception as error:  # a broken plugin must name itself
-                raise RegistryError(
-                    f"adapter {point.name!r} ({point.value}) cannot be loaded: {error}"
-                ) from error
-            declared = getattr(loaded, "name", None)
-            if declared != point.name:
-                raise RegistryError(
-                    f"adapter entry point {point.name!r} ({point.value}) declares "
-                    f"name = {declared!r}; expected {point.name!r}"
-                )
-            entries[point.name] = loaded
-        return cls(entries)
-
-    def with_adapter(self, adapter: AdapterType) -> AdapterRegistry:
-        """A copy of this registry with ``adapter`` added under its own name."""
-        return AdapterRegistry({**self._entries, adapter.name: adapter})
-
-    def names(self) -> list[str]:
-        """Registered names, sorted."""
-        return sorted(self._entries)
-
-    def get(self, name: str) -> AdapterType:
-        """Return the adapter type registered as ``name``.
-
-        Raises:
-            RegistryError: for an unknown name, suggesting the nearest ones.
-        """
-        found = self._entries.get(name)
-        if found is None:
-            close = difflib.get_close_matches(name, self.names(), n=3, cutoff=0.5)
-            hint = f"; did you mean {', '.join(repr(c) for c in close)}?" if close else ""
-            raise RegistryError(
-                f"unknown adapter {name!r}{hint} (registered: {', '.join(self.names())})"
-            )
-        return found
+    def with_adapter(self, adapter: Any) -> AdapterRegistry:
+        """A copy of this registry with ``adapter`` added under its own ``name``."""
+        copy = AdapterRegistry({**self._entries, adapter.name: adapter})
+        copy._loaded = {k: v for k, v in self._loaded.items() if k != adapter.name}
+        return copy
 
     def resolve(self, names: Iterable[str]) -> list[str]:
         """Order ``names`` and their requirements so that requirements come first.
@@ -85,7 +264,7 @@ class AdapterRegistry:
         Among independent adapters the given order is kept; the result is deterministic.
 
         Raises:
-            RegistryError: for an unknown name or a requirement cycle.
+            RegistryError: for an unknown or broken adapter, or a requirement cycle.
         """
         ordered: list[str] = []
         visiting: list[str] = []

@@ -3,55 +3,60 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
-from cosim.core.adapter import Adapter, RunContext
+from cosim.core.adapter import Adapter, Driver, RunContext
 from cosim.core.bus import Bus
 from cosim.core.errors import ConfigError
 from cosim.core.kernel import Kernel
 from cosim.core.recorder import Recorder
-from cosim.core.registry import AdapterRegistry
+from cosim.core.registry import AdapterRegistry, Registry
 from cosim.core.rng import RngStreams
 from cosim.scenario.fields import model_problem
 from cosim.scenario.model import Scenario
 from models.errors import ModelError
 
-DRIVERS: dict[str, list[str]] = {
-    "tasks": ["navigation", "task_source", "dta"],
-    "navigation": ["navigation", "goals"],
-    "waypoints": ["waypoints"],
-    "wander": ["wander"],
-}
-"""The adapters that make up each ``robots.driver``."""
+
+def driver_registry() -> Registry[Driver]:
+    """The robot drivers installed packages register (``cosim.drivers``)."""
+    return Registry.installed("driver", _driver_contract)
+
+
+def _driver_contract(name: str, loaded: Any) -> str | None:
+    if not isinstance(loaded, Driver):
+        return f"is a {type(loaded).__name__}; expected a cosim.core.adapter.Driver"
+    return None
 
 
 def adapter_names(scenario: Scenario, *, recording: bool = False) -> list[str]:
     """The adapters a scenario runs, before requirements are resolved.
 
-    ``recording`` adds the ROS interface (clock, frames, map, markers) that bags and the
-    live view carry; it changes no table.
+    The world, fleet, network and collision checks always; the lidar with beams; what each
+    section's settings ask for (a section may declare ``adapters()``: mapping when
+    enabled, the mocap source, ...), in section order; the driver's adapters and the poses
+    table; the extra adapters of ``[scenario] adapters``. ``recording`` adds the ROS
+    interface (clock, frames, map, markers) that bags and the live view carry; it changes
+    no table.
 
     Raises:
         ConfigError: for combinations that cannot work (a lidar-driven behaviour without
             a lidar).
+        RegistryError: for a driver that cannot be loaded.
     """
-    driver = scenario.robots.driver
-    if driver in ("wander", "navigation", "tasks") and scenario.lidar.beams == 0:
+    driver = driver_registry().get(scenario.robots.driver)
+    if driver.needs_lidar and scenario.lidar.beams == 0:
         raise ConfigError(
-            f"{scenario.source}: [robots] driver = {driver!r}: expected lidar.beams > 0 "
-            "(it avoids what the lidar sees)"
+            f"{scenario.source}: [robots] driver = {scenario.robots.driver!r}: expected "
+            "lidar.beams > 0 (it avoids what the lidar sees)"
         )
     names = ["world", "fleet", "network", "collisions"]
     if scenario.lidar.beams > 0:
         names.append("lidar")
-    if scenario.mapping.enabled:
-        names.append("mapping")
-    if scenario.mocap.source != "none":
-        names.append("mocap")
-    if scenario.physical.robots:
-        names.append("physical")
-    if scenario.humans.enabled:
-        names.append("humans")
-    names += DRIVERS[driver] + ["poses"]
+    for section in scenario.sections.values():
+        asks = getattr(section, "adapters", None)
+        if callable(asks):
+            names += [name for name in asks() if name not in names]
+    names += [*driver.adapters, "poses"]
     if recording:
         names.append("ros_interface")
     names += [name for name in scenario.scenario.adapters if name not in names]
@@ -75,8 +80,15 @@ def check_scenario(
 
 
 def needs_realtime(scenario: Scenario) -> bool:
-    """Whether the scenario talks to the real world (physical robots, live mocap)."""
-    return bool(scenario.physical.robots) or scenario.mocap.source in ("motioncapture", "ros2")
+    """Whether the scenario talks to the real world (physical robots, live mocap).
+
+    A section says so by declaring ``needs_realtime()``.
+    """
+    for section in scenario.sections.values():
+        says = getattr(section, "needs_realtime", None)
+        if callable(says) and says():
+            return True
+    return False
 
 
 @dataclass

@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from typing import Any, Literal, TypeVar, Union, get_args, get_origin, get_type_hints
 
 from cosim.core.errors import ConfigError, ScenarioError
+from cosim.core.registry import Registry, suggest_names
 from models.errors import ModelError
 
 
@@ -65,16 +66,20 @@ def param(
     le: float | None = None,
     lt: float | None = None,
     path: bool = False,
+    registry: str | None = None,
 ) -> Any:
     """Declare a configuration field with a default, a one-line doc and numeric bounds.
 
     ``path=True`` marks a file name: a relative one is resolved against the folder of the
     scenario file when the scenario is loaded (against the working folder for presets and
     ``--set``), so the resolved scenario names an absolute file.
+
+    ``registry`` names a registry kind (``"protocol"``, ``"controller"``, ...: see
+    :data:`cosim.core.registry.GROUPS`): the value (or every element of a list) must be a
+    name registered there; an unknown one is refused with the registered names.
     """
-    return field(
-        default=default, metadata={"doc": doc, "bounds": Bounds(ge, gt, le, lt), "path": path}
-    )
+    metadata = {"doc": doc, "bounds": Bounds(ge, gt, le, lt), "path": path, "registry": registry}
+    return field(default=default, metadata=metadata)
 
 
 @dataclass(frozen=True, slots=True)
@@ -311,6 +316,9 @@ def build(
                 if isinstance(value, tuple):
                     expected += " (every element)"
                 raise ConfigError(format_problem(origin, section, key, raw, expected))
+        kind = fields[key].metadata.get("registry")
+        if kind is not None:
+            _check_registered(kind, value, origin, section, key, raw)
         values[key] = value
     instance = cls(**values)
     problems = getattr(instance, "problems", None)
@@ -321,6 +329,15 @@ def build(
                 format_problem(origin, section, problem.key, problem.value, problem.expected)
             )
     return instance
+
+
+def _check_registered(kind: str, value: Any, origin: str, section: str, key: str, raw: Any) -> None:
+    """Refuse a name (or a list's name) that is not registered in the ``kind`` registry."""
+    registry = Registry.installed(kind)
+    for name in value if isinstance(value, tuple) else (value,):
+        if name not in registry:
+            expected = f"a registered {registry.words}" + suggest_names(name, registry.names())
+            raise ConfigError(format_problem(origin, section, key, raw, expected))
 
 
 def _table_item_type(hint: Any) -> type[Any] | None:

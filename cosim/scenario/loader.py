@@ -11,9 +11,9 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from cosim.core.errors import ConfigError
+from cosim.core.errors import ConfigError, RegistryError
 from cosim.scenario.fields import build, show_name, show_value, suggest
-from cosim.scenario.model import Scenario, section_types
+from cosim.scenario.model import Scenario, section_classes, section_registry
 from cosim.scenario.tomlfile import parse_toml, read_toml_file
 
 PRESET_PACKAGE = "cosim.presets"
@@ -113,28 +113,39 @@ def load_scenario(
     return _build(raw, origin, origins)
 
 
+def section_types() -> dict[str, type[Any]]:
+    """Section name -> settings dataclass, for every registered section that loads, in order."""
+    return section_classes()
+
+
 def _build(raw: dict[str, Any], origin: str, origins: dict[tuple[str, str], str]) -> Scenario:
-    types = section_types()
-    built: dict[str, Any] = {}
-    for section, table in raw.items():
-        if section not in types:
+    registry = section_registry()
+    for section in raw:
+        if section not in registry:
             where = next((o for (s, _), o in origins.items() if s == section), origin)
             raise ConfigError(
-                f"{where}: unknown section [{show_name(section)}]" + suggest(section, list(types))
+                f"{where}: unknown section [{show_name(section)}]"
+                + suggest(section, registry.names())
+                + " (sections come from installed packages: `cosim plugins` lists them)"
             )
+    try:
+        classes = section_classes(needed=raw.keys())
+    except RegistryError as error:  # the file uses a plugin that cannot load: say which
+        raise ConfigError(f"{origin}: {error}") from None
+    built: dict[str, Any] = {}
+    for section, cls in classes.items():
+        table = raw.get(section, {})
         if not isinstance(table, dict):
             raise ConfigError(
                 f"{origin}: {section} = {show_value(table)}: expected a [{section}] table of keys"
             )
         key_origins = {key: origins.get((section, key), origin) for key in table}
-        table, key_origins = _apply_profile(types[section], table, key_origins, section, origin)
+        table, key_origins = _apply_profile(cls, table, key_origins, section, origin)
         built[section] = _resolve_paths(
-            build(
-                types[section], table, section=section, origins=key_origins, default_origin=origin
-            ),
+            build(cls, table, section=section, origins=key_origins, default_origin=origin),
             key_origins,
         )
-    return Scenario(**built, source=origin)
+    return Scenario(built, source=origin)
 
 
 def _resolve_paths(section: Any, origins: Mapping[str, str]) -> Any:
@@ -201,8 +212,7 @@ def dump_scenario(scenario: Scenario) -> str:
     Loading the text back gives an equal :class:`Scenario`.
     """
     lines = [f"# resolved from {scenario.source}"]
-    for name in section_types():
-        section = getattr(scenario, name)
+    for name, section in scenario.sections.items():
         lines.append("")
         lines.append(f"[{name}]")
         for f in fields(section):

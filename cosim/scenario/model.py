@@ -1,28 +1,53 @@
-"""The resolved scenario: one frozen dataclass per section."""
+"""The resolved scenario: one frozen settings dataclass per section, by section name.
+
+Sections are registered in the ``cosim.sections`` entry-point group, cosim's own as a
+plugin package's: the core sections (``scenario``, ``world``, ``robots``, ``lidar``,
+``odometry``, ``record``) here in :mod:`cosim.scenario.sections`, every capability's with
+its adapters (``[navigation]`` in ``adapters/navigation/settings.py``, ...). Code reads a
+section by its type, ``scenario.section(NavigationConfig)``; ``scenario.navigation`` reads
+it by name (untyped).
+"""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields, replace
-from typing import Any, TypeVar, get_type_hints
+from collections.abc import Collection, Iterator, Mapping
+from dataclasses import dataclass, field, replace
+from types import MappingProxyType
+from typing import Any, TypeVar
 
 from cosim.core.errors import RegistryError
-from cosim.scenario.humans import HumansConfig
-from cosim.scenario.mapping import MappingConfig
-from cosim.scenario.mixed import MocapConfig, PhysicalConfig
-from cosim.scenario.network import NetworkConfig
+from cosim.core.registry import Registry
 from cosim.scenario.sections import (
-    AssignmentConfig,
     LidarConfig,
-    NavigationConfig,
     OdometryConfig,
     RecordConfig,
     RobotsConfig,
     ScenarioSection,
-    TasksConfig,
     WorldConfig,
 )
 
 S = TypeVar("S")
+
+CORE_SECTIONS = ("scenario", "world", "robots", "lidar", "odometry", "record")
+"""Sections every scenario has, whatever is installed."""
+
+
+def section_registry() -> Registry[type[Any]]:
+    """The settings sections installed packages register (``cosim.sections``)."""
+    return Registry.installed("section", _section_contract)
+
+
+def _section_contract(name: str, loaded: Any) -> str | None:
+    """A section must be a dataclass type whose every field has a default."""
+    import dataclasses
+
+    if not (isinstance(loaded, type) and dataclasses.is_dataclass(loaded)):
+        return "is not a dataclass (declare the section's keys with param(default, doc))"
+    try:
+        loaded()
+    except TypeError as error:
+        return f"cannot be built from defaults alone ({error}): give every key a default"
+    return None
 
 
 @dataclass(frozen=True)
@@ -30,39 +55,90 @@ class Scenario:
     """A validated scenario. Build it with :func:`cosim.load_scenario`.
 
     Attributes:
+        sections: section name -> its settings, in file order (core sections first).
         source: the file or preset it was loaded from (for messages and provenance).
     """
 
-    scenario: ScenarioSection = field(default_factory=ScenarioSection)
-    world: WorldConfig = field(default_factory=WorldConfig)
-    robots: RobotsConfig = field(default_factory=RobotsConfig)
-    lidar: LidarConfig = field(default_factory=LidarConfig)
-    odometry: OdometryConfig = field(default_factory=OdometryConfig)
-    network: NetworkConfig = field(default_factory=NetworkConfig)
-    navigation: NavigationConfig = field(default_factory=NavigationConfig)
-    tasks: TasksConfig = field(default_factory=TasksConfig)
-    assignment: AssignmentConfig = field(default_factory=AssignmentConfig)
-    mapping: MappingConfig = field(default_factory=MappingConfig)
-    mocap: MocapConfig = field(default_factory=MocapConfig)
-    physical: PhysicalConfig = field(default_factory=PhysicalConfig)
-    humans: HumansConfig = field(default_factory=HumansConfig)
-    record: RecordConfig = field(default_factory=RecordConfig)
+    sections: Mapping[str, Any] = field(default_factory=dict)
     source: str = field(default="<defaults>", compare=False)
+    _by_type: Mapping[type[Any], Any] = field(
+        default_factory=dict, init=False, repr=False, compare=False
+    )
 
     def __post_init__(self) -> None:
-        by_type = {type(getattr(self, f.name)): getattr(self, f.name) for f in fields(self)}
-        object.__setattr__(self, "_by_type", by_type)
+        sections = dict(self.sections)
+        for name, kind in zip(
+            CORE_SECTIONS,
+            (ScenarioSection, WorldConfig, RobotsConfig, LidarConfig, OdometryConfig, RecordConfig),
+            strict=True,
+        ):
+            sections.setdefault(name, kind())
+        object.__setattr__(self, "sections", MappingProxyType(sections))
+        object.__setattr__(self, "_by_type", {type(s): s for s in sections.values()})
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        # the mapping proxy does not pickle: studies send scenarios to worker processes
+        return (Scenario, (dict(self.sections), self.source))
 
     def section(self, kind: type[S]) -> S:
         """The section of type ``kind``.
 
         Raises:
-            RegistryError: if no section of the scenario has that type.
+            RegistryError: if no section of the scenario has that type (its package is not
+                installed, or does not register it in ``cosim.sections``).
         """
-        found = self._by_type.get(kind)  # type: ignore[attr-defined]
+        found = self._by_type.get(kind)
         if found is None:
-            raise RegistryError(f"the scenario has no section of type {kind.__name__}")
+            raise RegistryError(
+                f"{self.source}: no section of type {kind.__name__}: register it in the "
+                "cosim.sections entry-point group (registered here: "
+                f"{', '.join(self.sections)})"
+            )
         return found  # type: ignore[no-any-return]
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("__"):
+            raise AttributeError(name)
+        sections = object.__getattribute__(self, "sections")
+        try:
+            return sections[name]
+        except KeyError:
+            raise AttributeError(
+                f"the scenario has no section {name!r} (sections: {', '.join(sections)})"
+            ) from None
+
+    def __iter__(self) -> Iterator[tuple[str, Any]]:
+        return iter(self.sections.items())
+
+    @property
+    def scenario(self) -> ScenarioSection:
+        """``[scenario]``: name, duration, seed, extra adapters."""
+        return self.sections["scenario"]  # type: ignore[no-any-return]
+
+    @property
+    def world(self) -> WorldConfig:
+        """``[world]``: the warehouse hall."""
+        return self.sections["world"]  # type: ignore[no-any-return]
+
+    @property
+    def robots(self) -> RobotsConfig:
+        """``[robots]``: the fleet."""
+        return self.sections["robots"]  # type: ignore[no-any-return]
+
+    @property
+    def lidar(self) -> LidarConfig:
+        """``[lidar]``: every robot's planar lidar."""
+        return self.sections["lidar"]  # type: ignore[no-any-return]
+
+    @property
+    def odometry(self) -> OdometryConfig:
+        """``[odometry]``: every robot's wheel odometry."""
+        return self.sections["odometry"]  # type: ignore[no-any-return]
+
+    @property
+    def record(self) -> RecordConfig:
+        """``[record]``: what the run keeps."""
+        return self.sections["record"]  # type: ignore[no-any-return]
 
     @property
     def seed(self) -> int:
@@ -74,16 +150,48 @@ class Scenario:
         """The scenario name."""
         return self.scenario.name
 
+    def with_section(self, name: str, section: Any) -> Scenario:
+        """Return a copy with section ``name`` replaced."""
+        return Scenario({**self.sections, name: section}, self.source)
+
     def with_seed(self, seed: int) -> Scenario:
         """Return a copy with another seed."""
-        return replace(self, scenario=replace(self.scenario, seed=seed))
+        return self.with_section("scenario", replace(self.scenario, seed=seed))
 
     def with_duration(self, duration_s: float) -> Scenario:
         """Return a copy with another duration (s)."""
-        return replace(self, scenario=replace(self.scenario, duration_s=duration_s))
+        return self.with_section("scenario", replace(self.scenario, duration_s=duration_s))
 
 
-def section_types() -> dict[str, type[Any]]:
-    """Section name -> section dataclass, in file order."""
-    hints = get_type_hints(Scenario)
-    return {f.name: hints[f.name] for f in fields(Scenario) if f.name != "source"}
+LAST = 1000
+"""Where a section that declares no ``ORDER`` comes (after cosim's own, by name)."""
+
+
+def section_classes(needed: Collection[str] = ()) -> dict[str, type[Any]]:
+    """Every registered section that loads, by name, in order (``ORDER``, then name).
+
+    A plugin's section that cannot be imported is left out, so that it stops no run that
+    does not use it; one in ``needed`` (the scenario names it) is an error.
+
+    Raises:
+        RegistryError: naming the section's package, for a section in ``needed``.
+    """
+    registry = section_registry()
+    classes: dict[str, type[Any]] = {}
+    for name in registry.names():
+        try:
+            classes[name] = registry.get(name)
+        except RegistryError:
+            if name in needed:
+                raise
+    return dict(
+        sorted(classes.items(), key=lambda item: (getattr(item[1], "ORDER", LAST), item[0]))
+    )
+
+
+def default_scenario() -> Scenario:
+    """Every registered section with its defaults (sections that cannot load left out)."""
+    return Scenario({name: kind() for name, kind in section_classes().items()})
+
+
+__all__ = ["CORE_SECTIONS", "Scenario", "default_scenario", "section_classes", "section_registry"]

@@ -275,14 +275,15 @@ def test_with_one_way_lanes_robots_reach_goals_without_collision_and_repair_thei
 
 
 def test_an_unknown_traffic_policy_is_refused_naming_the_key_and_the_choices():
-    expected = r"\[navigation\] traffic = 'roundabouts': expected one of 'none', 'lanes', 'pibt'"
-    with pytest.raises(cosim.ConfigError, match=expected):
+    expected = r"\[navigation\] traffic = 'roundabouts': expected a registered traffic policy"
+    with pytest.raises(cosim.ConfigError, match=expected) as refused:
         cosim.load_scenario("fleet50", {"navigation.traffic": "roundabouts"})
+    assert "(registered: lanes, none, pibt)" in str(refused.value)
 
 
 def test_robots_that_map_drive_on_the_buildings_lanes_laid_into_their_wider_maps():
     from adapters.navigation.layers import lanes_on
-    from adapters.navigation.stack import LANE_WIDTH_M
+    from adapters.navigation.traffic_policies import LANE_WIDTH_M
     from adapters.world.warehouse import scenario_warehouse
     from models.navigation.costmap import CostmapParams, StaticCostmap
     from models.navigation.lanes import TWO_WAY, aisle_lanes

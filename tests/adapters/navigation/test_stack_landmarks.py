@@ -1,5 +1,6 @@
 import pytest
 
+import adapters.navigation.astar as astar
 import adapters.navigation.planning as planning
 import cosim
 from models.navigation.landmarks import Landmarks
@@ -15,9 +16,10 @@ FLEET = {
 
 def _spy(monkeypatch: pytest.MonkeyPatch, min_cells: int) -> list[tuple[str, Landmarks | None]]:
     """Lower or raise the size threshold; record the landmarks every search is given."""
-    monkeypatch.setattr(planning, "ALT_MIN_CELLS", min_cells)
+    monkeypatch.setattr(planning, "ALT_MIN_CELLS", min_cells)  # the yardstick's searches
+    monkeypatch.setattr(astar, "ALT_MIN_CELLS", min_cells)  # the A* planner's
     calls: list[tuple[str, Landmarks | None]] = []
-    plan, yardstick = planning.plan, planning.shortest_path_length_m
+    plan, yardstick = astar.plan, planning.shortest_path_length_m
 
     def spy_plan(*args, **kwargs):
         calls.append(("plan", kwargs.get("landmarks")))
@@ -27,7 +29,7 @@ def _spy(monkeypatch: pytest.MonkeyPatch, min_cells: int) -> list[tuple[str, Lan
         calls.append(("yardstick", kwargs.get("landmarks")))
         return yardstick(*args, **kwargs)
 
-    monkeypatch.setattr(planning, "plan", spy_plan)
+    monkeypatch.setattr(astar, "plan", spy_plan)
     monkeypatch.setattr(planning, "shortest_path_length_m", spy_yardstick)
     return calls
 
@@ -54,6 +56,7 @@ def test_above_the_size_threshold_every_robot_plans_with_the_same_landmarks(monk
     # the same goals, planned to paths of the same cost (equal-cost paths may differ)
     calls.clear()
     monkeypatch.setattr(planning, "ALT_MIN_CELLS", 10**12)
+    monkeypatch.setattr(astar, "ALT_MIN_CELLS", 10**12)
     plain = cosim.run(cosim.load_scenario("fleet50", fleet))
     assert all(marks is None for _, marks in calls)
     assert fast.summary["goals_sent"] == plain.summary["goals_sent"]

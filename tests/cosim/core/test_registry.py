@@ -4,27 +4,37 @@ from cosim.core.errors import RegistryError
 from cosim.core.registry import AdapterRegistry
 
 
-class _A:
+class _Adapter:
+    """Starts and finishes (the contract's methods)."""
+
+    def start(self, run):
+        pass
+
+    def finish(self, run):
+        return {}
+
+
+class _A(_Adapter):
     name = "a"
     requires: tuple[str, ...] = ()
 
 
-class _B:
+class _B(_Adapter):
     name = "b"
     requires = ("a",)
 
 
-class _C:
+class _C(_Adapter):
     name = "c"
     requires = ("b", "a")
 
 
-class _Loop1:
+class _Loop1(_Adapter):
     name = "loop1"
     requires = ("loop2",)
 
 
-class _Loop2:
+class _Loop2(_Adapter):
     name = "loop2"
     requires = ("loop1",)
 

@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 import cosim
 from cosim.cli.main import main
 from cosim.core.errors import CosimError
-from cosim.scenario.model import section_types
+from cosim.scenario.loader import section_types
 from cosim.studies import load_study
 
 SECTIONS = section_types()

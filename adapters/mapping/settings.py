@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass
-from typing import Literal
+from typing import ClassVar, Literal
 
 from cosim.scenario.fields import Problem, param
 
@@ -18,6 +18,9 @@ from cosim.scenario.fields import Problem, param
 @dataclass(frozen=True)
 class MappingConfig:
     """``[mapping]``: per-robot occupancy mapping, pose correction and map sharing."""
+
+    ORDER: ClassVar[int] = 90
+    """Where the section comes in a resolved scenario and in the adapters' order."""
 
     enabled: bool = param(
         False,
@@ -78,3 +81,7 @@ class MappingConfig:
                 "false with share = 'maps' (a map rebuilt after a loop closure would be sent "
                 "again on top of what the neighbours hold; share 'scans' instead)",
             )
+
+    def adapters(self) -> tuple[str, ...]:
+        """The adapters these settings ask for: the robots' mapping when enabled."""
+        return ("mapping",) if self.enabled else ()

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass
+from typing import ClassVar
 
 from cosim.scenario.fields import Problem, param
 
@@ -18,6 +19,9 @@ from cosim.scenario.fields import Problem, param
 @dataclass(frozen=True)
 class HumansConfig:
     """``[humans]``: people and forklifts sharing the aisles with the robots (SUMO)."""
+
+    ORDER: ClassVar[int] = 120
+    """Where the section comes in a resolved scenario and in the adapters' order."""
 
     workers: int = param(0, "workers walking between pick stations and the dock", ge=0, le=2000)
     forklifts: int = param(0, "forklifts driving between pick stations and the dock", ge=0, le=200)
@@ -89,3 +93,7 @@ class HumansConfig:
     def people(self) -> int:
         """Workers, standing ones included."""
         return self.workers + len(self.standing)
+
+    def adapters(self) -> tuple[str, ...]:
+        """The adapters these settings ask for: SUMO's people, with workers or forklifts."""
+        return ("humans",) if self.enabled else ()

@@ -112,6 +112,9 @@ class PartitionConfig:
 class NetworkConfig:
     """``[network]``: the links between hosts (robots and the base station)."""
 
+    ORDER: ClassVar[int] = 50
+    """Where the section comes in a resolved scenario and in the adapters' order."""
+
     PROFILES: ClassVar[Mapping[str, Mapping[str, Any]]] = PROFILES
 
     profile: Profile = param("ideal", "preset of the link keys; explicit keys override it")

@@ -1,0 +1,23 @@
+"""cosim's own robot drivers, registered in ``cosim.drivers`` as a plugin's are.
+
+A driver is the robot software a scenario runs (``robots.driver``): a set of adapters.
+"""
+
+from __future__ import annotations
+
+from cosim.core.adapter import Driver
+
+NAVIGATION = Driver(
+    ("navigation", "goals"),
+    "navigation (the Nav2 role) to random reachable goals, or to navigation.goals in turn",
+)
+TASKS = Driver(
+    ("navigation", "task_source", "dta"),
+    "dynamic task assignment over the network (assignment.protocol), driving through navigation",
+)
+WAYPOINTS = Driver(
+    ("waypoints",),
+    "straight-line random waypoints with a go-to-goal controller, avoiding nothing",
+    needs_lidar=False,
+)
+WANDER = Driver(("wander",), "reactive roaming that steers away from what the lidar sees")
