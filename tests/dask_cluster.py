@@ -20,11 +20,16 @@ class DaskCluster:
 
 
 @contextmanager
-def dask_cluster(folder: Path, *, workers: int = 2, threads: int = 1) -> Iterator[DaskCluster]:
-    """Start a scheduler and ``workers`` worker processes of ``threads`` threads each."""
+def dask_cluster(
+    folder: Path, *, workers: int = 2, threads: int = 1, env: dict[str, str] | None = None
+) -> Iterator[DaskCluster]:
+    """Start a scheduler and ``workers`` worker processes of ``threads`` threads each.
+
+    ``env`` adds to the processes' environment (a ``PYTHONPATH`` with plugins, say).
+    """
     dask = str(Path(sys.executable).parent / "dask")
     scheduler_file = folder / "scheduler.json"
-    env = {**os.environ, "DASK_DISTRIBUTED__WORKER__DAEMON": "False"}
+    env = {**os.environ, "DASK_DISTRIBUTED__WORKER__DAEMON": "False", **(env or {})}
     quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL, "env": env}
     procs = [
         subprocess.Popen(

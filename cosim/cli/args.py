@@ -43,6 +43,17 @@ def _non_negative_float(text: str) -> float:
     return value
 
 
+REGISTRY_KINDS = ("adapter", "section", "driver", "protocol", "controller", "planner", "traffic")
+
+
+def _registry_kind(text: str) -> str:
+    if text not in REGISTRY_KINDS:
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not a registry; expected one of {', '.join(REGISTRY_KINDS)}"
+        )
+    return text
+
+
 def _positive_int(text: str) -> int:
     value = _non_negative_int(text)
     if value == 0:
@@ -330,5 +341,24 @@ def build_parser() -> argparse.ArgumentParser:
         "scenarios",
         help="list the presets, one line each",
         description="List the scenario presets shipped with cosim.",
+    )
+    listing = commands.add_parser(
+        "plugins",
+        help="list every registered adapter, section, driver, protocol, controller, planner "
+        "and traffic policy",
+        description=(
+            "List what installed packages register, cosim's own built-ins beside any plugin's: "
+            "each entry with the package it comes from and a one-line description. A plugin "
+            "that cannot be loaded is listed with the reason (it stops no run that does not "
+            "use it)."
+        ),
+    )
+    listing.add_argument(
+        "kinds",
+        nargs="*",
+        metavar="KIND",
+        type=_registry_kind,
+        help="only these registries (adapter, section, driver, protocol, controller, planner, "
+        "traffic); default: all",
     )
     return parser

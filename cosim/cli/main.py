@@ -323,6 +323,14 @@ def _cmd_scenarios(_args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _cmd_plugins(args: argparse.Namespace) -> int:
+    from cosim.cli.plugins import KINDS, plugin_lines
+
+    for line in plugin_lines(args.kinds or KINDS):
+        print(line)
+    return EXIT_OK
+
+
 def _cmd_standin(args: argparse.Namespace) -> int:
     from adapters.physical.standin import serve
 
@@ -338,6 +346,7 @@ COMMANDS = {
     "map": _cmd_map,
     "plot": _cmd_plot,
     "scenarios": _cmd_scenarios,
+    "plugins": _cmd_plugins,
     "standin": _cmd_standin,
 }
 

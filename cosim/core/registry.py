@@ -19,7 +19,7 @@ import difflib
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from functools import cache
-from importlib.metadata import EntryPoint, entry_points
+from importlib.metadata import entry_points
 from typing import Any, Generic, TypeVar
 
 from cosim.core.errors import RegistryError
@@ -56,6 +56,36 @@ Check = Callable[[str, Any], str | None]
 
 
 @dataclass(frozen=True)
+class Lazy:
+    """An entry point, imported on first use.
+
+    Wrapped, because the entry points of ``importlib.metadata`` and of its backport
+    ``importlib_metadata`` (which some packages install into the import system) are
+    different classes with the same attributes.
+
+    Attributes:
+        point: the entry point (``load()``, ``name``, ``value``, ``dist``).
+    """
+
+    point: Any
+
+    def load(self) -> Any:
+        """Import the entry point's object."""
+        return self.point.load()
+
+    @property
+    def value(self) -> str:
+        """``module:attribute``."""
+        return str(self.point.value)
+
+    @property
+    def package(self) -> str:
+        """The distribution that declares the entry point."""
+        dist = getattr(self.point, "dist", None)
+        return str(dist.name) if dist is not None else "?"
+
+
+@dataclass(frozen=True)
 class Plugin:
     """One registered entry, as ``cosim plugins`` lists it.
 
@@ -88,11 +118,11 @@ class Registry(Generic[T]):
     def __init__(
         self,
         kind: str,
-        entries: Mapping[str, EntryPoint | T],
+        entries: Mapping[str, Lazy | T],
         check: Check | None = None,
     ) -> None:
         self.kind = kind
-        self._entries: dict[str, EntryPoint | T] = dict(entries)
+        self._entries: dict[str, Lazy | T] = dict(entries)
         self._loaded: dict[str, T] = {}
         self._check = check
 
@@ -126,14 +156,14 @@ class Registry(Generic[T]):
     def package(self, name: str) -> str:
         """The distribution that registers ``name`` (``cosim`` for the built-ins)."""
         entry = self._entries.get(name)
-        if isinstance(entry, EntryPoint):
-            return entry.dist.name if entry.dist is not None else "?"
+        if isinstance(entry, Lazy):
+            return entry.package
         return "(given in code)"
 
     def target(self, name: str) -> str:
         """Where ``name`` comes from: ``module:attribute``."""
         entry = self._entries[name]
-        if isinstance(entry, EntryPoint):
+        if isinstance(entry, Lazy):
             return entry.value
         return f"{getattr(entry, '__module__', '?')}:{getattr(entry, '__qualname__', '?')}"
 
@@ -156,7 +186,7 @@ class Registry(Generic[T]):
             raise self.unknown(name)
         where = f"{self.words} {name!r} ({self.target(name)}, package {self.package(name)})"
         loaded: Any = entry
-        if isinstance(entry, EntryPoint):
+        if isinstance(entry, Lazy):
             try:
                 loaded = entry.load()
             except Exception as error:  # a broken plugin must name itself
@@ -209,18 +239,14 @@ def suggest_names(name: str, names: Iterable[str]) -> str:
 
 
 @cache
-def _entry_points(group: str) -> dict[str, EntryPoint]:
-    """A group's entry points, cosim's first in declaration order, then by package name."""
-    found = list(entry_points(group=group))
-
-    def package(point: EntryPoint) -> str:
-        return point.dist.name if point.dist is not None else ""
-
-    ours = [p for p in found if package(p) == "cosim"]
-    theirs = sorted((p for p in found if package(p) != "cosim"), key=lambda p: package(p))
-    entries: dict[str, EntryPoint] = {}
-    for point in ours + theirs:
-        entries.setdefault(point.name, point)  # the first package to claim a name keeps it
+def _entry_points(group: str) -> dict[str, Lazy]:
+    """A group's entry points, cosim's first, then other packages' by package name."""
+    found = [Lazy(point) for point in entry_points(group=group)]
+    ours = [p for p in found if p.package == "cosim"]
+    theirs = sorted((p for p in found if p.package != "cosim"), key=lambda p: p.package)
+    entries: dict[str, Lazy] = {}
+    for lazy in ours + theirs:
+        entries.setdefault(lazy.point.name, lazy)  # the first package to claim a name keeps it
     return entries
 
 

@@ -70,13 +70,26 @@ def definition(msgtype: str) -> tuple[str, str]:
 
 
 def channel_specs(topics: Mapping[str, Advertisement]) -> list[ChannelSpec]:
-    """The channels of the given advertised topics, in their order."""
+    """The channels of the given advertised topics, in their order.
+
+    A plugin's own message type (one neither in ROS 2 Humble nor in ``cosim_msgs``) is
+    known by the ``.msg`` text its class declares as ``ros_definition``.
+    """
     specs = []
     for topic, ad in topics.items():
         msgtype = ad.message_type.ros_type
+        _register(msgtype, getattr(ad.message_type, "ros_definition", None))
         text, digest = definition(msgtype)
         specs.append(ChannelSpec(topic, msgtype, text, digest, ad.qos))
     return specs
+
+
+def _register(msgtype: str, text: str | None) -> None:
+    """Make a plugin's own message type known to the type store, from its ``.msg`` text."""
+    store = typestore()
+    if text is None or msgtype in store.fielddefs:
+        return
+    store.register(get_types_from_msg(text, msgtype))
 
 
 def recorded_qos(qos: TopicQos) -> list[Qos]:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -64,7 +65,11 @@ def adapter_names(scenario: Scenario, *, recording: bool = False) -> list[str]:
 
 
 def check_scenario(
-    scenario: Scenario, *, registry: AdapterRegistry | None = None, recording: bool = False
+    scenario: Scenario,
+    *,
+    registry: AdapterRegistry | None = None,
+    recording: bool = False,
+    extra: Sequence[str] = (),
 ) -> None:
     """Refuse combinations of sections that cannot work, before anything is built.
 
@@ -73,7 +78,9 @@ def check_scenario(
     combinations before the first run, :func:`assemble` before building the world.
     """
     registry = registry or AdapterRegistry.from_entry_points()
-    for name in registry.resolve(adapter_names(scenario, recording=recording)):
+    names = adapter_names(scenario, recording=recording)
+    names += [name for name in extra if name not in names]
+    for name in registry.resolve(names):
         check = getattr(registry.get(name), "check_scenario", None)
         if check is not None:
             check(scenario)
@@ -107,6 +114,7 @@ def assemble(
     realtime: bool = False,
     speed: float = 1.0,
     recording: bool = False,
+    extra: Sequence[str] = (),
 ) -> Assembly:
     """Build the run context and construct the scenario's adapters.
 
@@ -118,11 +126,13 @@ def assemble(
             scenarios that talk to the real world: :func:`needs_realtime`).
         speed: simulated seconds per wall-clock second when ``realtime``.
         recording: the run is recorded or viewed live (see :func:`adapter_names`).
+        extra: more adapters to run, by name (after the scenario's).
     """
     registry = registry or AdapterRegistry.from_entry_points()
     if names is None:
-        check_scenario(scenario, registry=registry, recording=recording)
+        check_scenario(scenario, registry=registry, recording=recording, extra=extra)
         names = adapter_names(scenario, recording=recording)
+        names += [name for name in extra if name not in names]
     ordered = registry.resolve(names)
     if needs_realtime(scenario):
         realtime, speed = True, 1.0

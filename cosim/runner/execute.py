@@ -6,7 +6,7 @@ import json
 import platform
 import shutil
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from importlib.metadata import version
 from pathlib import Path
@@ -16,7 +16,8 @@ import numpy as np
 import pandas as pd
 
 from adapters.world.files import write_map
-from cosim.core.errors import ExportError
+from cosim.core.adapter import AdapterType
+from cosim.core.errors import ExportError, RegistryError
 from cosim.core.kernel import Lateness
 from cosim.core.recorder import MapArtifact, Recorder, merge_counts
 from cosim.core.registry import AdapterRegistry
@@ -83,6 +84,7 @@ def execute(
     force: bool = False,
     live: LiveOptions | None = None,
     on_ready: Callable[[RecordingSession], None] | None = None,
+    adapters: Sequence[str | AdapterType] = (),
 ) -> RunResult:
     """Run a scenario to its duration and return its result.
 
@@ -101,12 +103,16 @@ def execute(
         live: serve the run to Foxglove over WebSocket, paced by the real-time kernel.
         on_ready: called with the recording session once sinks are open, before the run
             (the command line prints the live view's address there).
+        adapters: more adapters to run: registered names, or adapter classes (used for
+            this run as if registered under their ``name``).
     """
     plan = RecordingPlan.for_run(scenario, out, live)
+    registry, extra = with_adapters(registry or AdapterRegistry.from_entry_points(), adapters)
     assembly = assemble(
         scenario,
         names=names,
         registry=registry,
+        extra=extra,
         realtime=live is not None,
         speed=live.rate if live is not None else 1.0,
         recording=plan.active,
@@ -129,6 +135,23 @@ def execute(
     result.bag = plan.bag
     result.recorded = session.counts()
     return result
+
+
+def with_adapters(
+    registry: AdapterRegistry, adapters: Sequence[str | AdapterType]
+) -> tuple[AdapterRegistry, list[str]]:
+    """The registry with the adapter classes among ``adapters`` added, and every name."""
+    names = []
+    for adapter in adapters:
+        if isinstance(adapter, str):
+            names.append(adapter)
+            continue
+        name = getattr(adapter, "name", None)
+        if not isinstance(name, str) or not name:
+            raise RegistryError(f"adapter {adapter!r} has no name (a class attribute, a string)")
+        registry = registry.with_adapter(adapter)
+        names.append(name)
+    return registry, names
 
 
 def _run_assembled(
@@ -273,8 +296,16 @@ def run(
     progress: ProgressFn | None = None,
     live: LiveOptions | None = None,
     on_ready: Callable[[RecordingSession], None] | None = None,
+    adapters: Sequence[str | AdapterType] = (),
 ) -> RunResult:
     """Run a scenario; optionally write its folder.
+
+    ::
+
+        import cosim
+        scenario = cosim.load_scenario("warehouse-random", overrides={"robots.count": 8})
+        result = cosim.run(scenario, seed=3, adapters=[MySensorAdapter])
+        result.tables["poses"].groupby("robot").v_mps.mean()
 
     Args:
         scenario: from :func:`cosim.load_scenario`.
@@ -285,6 +316,9 @@ def run(
         progress: called with (sim s, duration s, wall s) during the run.
         live: serve the run live to Foxglove (see :class:`cosim.recording.foxglove.LiveOptions`).
         on_ready: called once the recording is set up, before the run starts.
+        adapters: more adapters to run: registered names, or adapter classes (a class is
+            used for this run as if registered under its ``name``; the resolved
+            ``scenario.toml`` cannot name it, so ``cosim run`` of that file runs without it).
 
     Returns:
         The run's summary and tables.
@@ -295,7 +329,13 @@ def run(
         scenario = scenario.with_duration(duration_s)
     folder = Path(out) if out is not None else None
     result = execute(
-        scenario, progress=progress, out=folder, force=force, live=live, on_ready=on_ready
+        scenario,
+        progress=progress,
+        out=folder,
+        force=force,
+        live=live,
+        on_ready=on_ready,
+        adapters=adapters,
     )
     if folder is not None:
         write_run(result, folder, tables=scenario.record.tables)

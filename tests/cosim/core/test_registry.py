@@ -58,7 +58,12 @@ def test_a_requirement_cycle_is_an_error_naming_the_cycle():
         REG.resolve(["loop1"])
 
 
-def test_the_installed_registry_comes_from_entry_points():
-    names = AdapterRegistry.from_entry_points().names()
-    assert names == sorted(names)
-    assert "fleet" in names
+def test_the_installed_registry_lists_cosims_own_adapters_first_then_plugins_by_package():
+    registry = AdapterRegistry.from_entry_points()
+    names = registry.names()
+    packages = [registry.package(name) for name in names]
+    ours = [n for n, p in zip(names, packages, strict=True) if p == "cosim"]
+    assert "fleet" in ours
+    assert names[: len(ours)] == ours
+    theirs = packages[len(ours) :]
+    assert theirs == sorted(theirs)

@@ -3,9 +3,11 @@ from typing import Any, ClassVar
 
 import numpy as np
 import pandas as pd
+import pytest
 
 import cosim
 from cosim.core.adapter import RunContext
+from cosim.core.hosts import HostId
 from cosim.core.kernel import Stage
 from cosim.core.registry import AdapterRegistry
 from cosim.runner.assembly import adapter_names
@@ -128,3 +130,57 @@ def test_summary_counts_messages_and_events(small_scenario):
     assert summary["messages_dropped"] == 0
     assert summary["events"] > 0
     assert summary["real_time_factor"] > 0
+
+
+class _Odometer:
+    """Counts the odometry messages of robot_1 (an adapter given in code, not registered)."""
+
+    name = "odometer"
+    requires = ("fleet",)
+
+    def __init__(self, run):
+        self.count = 0
+        self.table = run.recorder.table("odometer", ("t_s", "count"))
+
+    def start(self, run):
+        run.bus.subscribe("/robot_1/odom", HostId("robot_1"), self._on_odom(run))
+
+    def _on_odom(self, run):
+        def on_odom(message, envelope):
+            self.count += 1
+            self.table.append(t_s=run.kernel.now_ns / 1e9, count=self.count)
+
+        return on_odom
+
+    def finish(self, run):
+        return {"odometer_messages": self.count}
+
+
+class _NoFinish:
+    name = "no_finish"
+    requires = ()
+
+    def __init__(self, run):
+        pass
+
+    def start(self, run):
+        pass
+
+
+def test_an_adapter_class_given_to_run_runs_beside_the_scenarios(small_scenario):
+    result = cosim.run(small_scenario, seed=2, adapters=[_Odometer])
+    # odometry at robots.control_hz (20 Hz) for 3 s
+    assert result.summary["odometer_messages"] == 60
+    assert len(result.tables["odometer"]) == 60
+    again = cosim.run(small_scenario, seed=2, adapters=[_Odometer])
+    pd.testing.assert_frame_equal(result.tables["poses"], again.tables["poses"])
+
+
+def test_an_adapter_missing_finish_is_refused_before_the_run_naming_it(small_scenario):
+    with pytest.raises(cosim.RegistryError, match=r"adapter 'no_finish' .* has no finish\(run\)"):
+        cosim.run(small_scenario, adapters=[_NoFinish])
+
+
+def test_an_unknown_adapter_name_given_to_run_suggests_the_nearest(small_scenario):
+    with pytest.raises(cosim.RegistryError, match=r"unknown adapter 'lidr'; did you mean 'lidar'"):
+        cosim.run(small_scenario, adapters=["lidr"])

@@ -1,0 +1,145 @@
+"""The example plugin package, installed as a user would, used without editing cosim.
+
+labkit (``examples/labkit``) is installed into a folder of its own (``pip install
+--target``) and put on ``PYTHONPATH`` of the processes that use it: cosim's command line,
+a study's local workers, a Dask cluster's workers. cosim's own environment stays as it is.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from cosim.studies.worker import VOLATILE_METRICS
+from tests.conftest import REPO
+from tests.dask_cluster import dask_cluster
+
+pytestmark = pytest.mark.slow
+
+LABKIT = REPO / "examples" / "labkit"
+SHORT = ["--duration-s", "30", "--set", "robots.driver=tasks"]
+
+
+@pytest.fixture(scope="module")
+def plugins(tmp_path_factory: pytest.TempPathFactory) -> dict[str, str]:
+    """An environment with labkit installed (a folder on PYTHONPATH)."""
+    target = tmp_path_factory.mktemp("site")
+    subprocess.run(
+        [sys.executable, "-m", "pip", "install", "--quiet", "--no-deps", "--no-build-isolation",
+         "--target", str(target), str(LABKIT)],
+        check=True, capture_output=True, timeout=300,
+    )  # fmt: skip
+    return {**os.environ, "PYTHONPATH": os.pathsep.join([str(target), str(REPO)])}
+
+
+def cosim(
+    env: dict[str, str], *args: str, cwd: Path | None = None
+) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "cosim", *args],
+        capture_output=True, text=True, env=env, cwd=cwd, timeout=600,
+    )  # fmt: skip
+
+
+def test_cosim_plugins_lists_labkits_protocol_controller_adapter_and_sections_beside_the_built_ins(
+    plugins,
+):
+    done = cosim(plugins, "plugins")
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+
+    def entry(name: str, package: str) -> bool:
+        return any(line.split()[:2] == [name, package] for line in lines if line.startswith("  "))
+
+    for name in ("sequential_auction", "pure_pursuit", "rangefinder"):
+        assert entry(name, "labkit"), name
+    for name in ("distributed_simplex", "dwa", "lidar", "astar", "pibt"):
+        assert entry(name, "cosim"), name
+    assert "BROKEN" not in done.stdout
+
+
+def test_a_run_with_labkits_protocol_controller_and_sensor_repeats_exactly(plugins, tmp_path):
+    args = [
+        "run", "warehouse-random", *SHORT,
+        "--set", "assignment.protocol=sequential_auction",
+        "--set", "sequential_auction.settle_rounds=2",
+        "--set", "navigation.controller=pure_pursuit",
+        "--set", "pure_pursuit.cruise_mps=0.7",
+        "--set", 'scenario.adapters=["rangefinder"]',
+        "--set", 'record.topics=["*"]',
+    ]  # fmt: skip
+    first = cosim(plugins, *args, "--out", str(tmp_path / "a"))
+    assert first.returncode == 0, first.stderr
+    summary = json.loads((tmp_path / "a" / "summary.json").read_text())
+    assert summary["tasks_completed"] >= 1
+    assert summary["rangefinder_readings"] == 4 * 300  # 4 robots at 10 Hz for 30 s
+    ranges = pd.read_parquet(tmp_path / "a" / "tables" / "ranges.parquet")
+    assert list(ranges.columns) == ["t_s", "robot", "range_m"] and len(ranges) == 1200
+    resolved = (tmp_path / "a" / "scenario.toml").read_text()
+    assert "[sequential_auction]\nsettle_rounds = 2" in resolved
+    assert "[pure_pursuit]\ncruise_mps = 0.7" in resolved
+    info = cosim(plugins, "bag", "info", str(tmp_path / "a" / "bag"))
+    assert "sensor_msgs/msg/Range" in info.stdout
+    assert "labkit_msgs/msg/BidTable" in info.stdout
+    # the resolved scenario reproduces the run, tables and all
+    again = cosim(
+        plugins, "run", str(tmp_path / "a" / "scenario.toml"), "--out", str(tmp_path / "b")
+    )
+    assert again.returncode == 0, again.stderr
+    for table in ("poses", "tasks", "assignments", "ranges", "navigation"):
+        pd.testing.assert_frame_equal(
+            pd.read_parquet(tmp_path / "a" / "tables" / f"{table}.parquet").drop(
+                columns=["plan_ms"], errors="ignore"
+            ),
+            pd.read_parquet(tmp_path / "b" / "tables" / f"{table}.parquet").drop(
+                columns=["plan_ms"], errors="ignore"
+            ),
+        )
+
+
+@pytest.mark.parametrize(
+    ("setting", "fragment"),
+    [
+        (
+            "sequential_auction.settle_rounds=-1",
+            "[sequential_auction] settle_rounds = -1: expected an integer >= 0 and <= 100",
+        ),
+        ("sequential_auction.settle=1", "unknown key 'settle'; did you mean 'settle_rounds'?"),
+        ("pure_pursuit.cruise_mps=9", "[pure_pursuit] cruise_mps = 9: expected a number > 0"),
+        ("navigation.controller=pure_persuit", "did you mean 'pure_pursuit'?"),
+    ],
+)
+def test_a_plugins_settings_are_checked_like_the_built_ins(plugins, setting, fragment):
+    done = cosim(plugins, "check", "warehouse-random", "--set", setting)
+    assert done.returncode == 2
+    assert fragment in done.stderr, done.stderr
+    assert done.stderr.count("\n") == 1 and "Traceback" not in done.stderr
+
+
+def test_the_example_study_gives_the_same_rows_on_two_local_workers_and_on_dask(plugins, tmp_path):
+    local = cosim(plugins, "study", str(LABKIT / "study.toml"), "--out", str(tmp_path / "local"),
+                  "--workers", "2")  # fmt: skip
+    assert local.returncode == 0, local.stderr
+    with dask_cluster(tmp_path, workers=2, env={"PYTHONPATH": plugins["PYTHONPATH"]}) as cluster:
+        remote = cosim(plugins, "study", str(LABKIT / "study.toml"), "--out",
+                       str(tmp_path / "dask"), "--scheduler", cluster.address)  # fmt: skip
+    assert remote.returncode == 0, remote.stderr
+    rows = [
+        pd.read_parquet(tmp_path / folder / "results.parquet").sort_values("run_id")
+        for folder in ("local", "dask")
+    ]
+    assert set(rows[0]["status"]) == {"ok"} and len(rows[0]) == 16
+    assert set(rows[0]["assignment.protocol"]) == {"distributed_simplex", "sequential_auction"}
+    volatile = [c for c in VOLATILE_METRICS if c in rows[0].columns]
+    pd.testing.assert_frame_equal(
+        rows[0].drop(columns=volatile).reset_index(drop=True),
+        rows[1].drop(columns=volatile).reset_index(drop=True),
+    )
+    auction = rows[0][rows[0]["assignment.protocol"] == "sequential_auction"]
+    assert (auction["tasks_completed"] > 0).all()
