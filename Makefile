@@ -9,7 +9,7 @@ OUT    ?= runs/demo
 STUDIES := runs/studies
 STUDY = $(BIN)/cosim study studies/$(1).toml --out $(STUDIES)/$(1) --resume
 
-.PHONY: setup demo test test-fast lint bench clean help reproduce study-comm study-comm-reduced \
+.PHONY: setup demo test test-fast docs lint bench clean help reproduce study-comm study-comm-reduced \
 	study-burst study-scale study-paper study-nav study-mapping study-mapping-reduced map-aces \
 	lab-real lab-mixed study-humans study-humans-reduced study-traffic
 
@@ -28,15 +28,20 @@ setup: $(STAMP)  ## create .venv and install cosim with its dev tools
 demo: setup  ## run the default scenario and say where the results are
 	$(BIN)/cosim run $(SCENARIO) --out $(OUT) --force
 
-test: setup  ## the whole test suite, on every core (CI runs this)
+test: setup docs  ## the documentation build and the whole test suite, on every core (CI runs this)
 	$(BIN)/python -m pytest -q -n auto
 
 test-fast: setup  ## all but the slow tests (whole runs, SUMO, DDS, Dask, real time), on every core
 	$(BIN)/python -m pytest -q -n auto -m "not slow"
 
+DOCS_ENV := NO_MKDOCS_2_WARNING=1 DISABLE_MKDOCS_2_WARNING=true
+docs: setup  ## the documentation site -> site/index.html (strict: a broken reference fails the build)
+	$(DOCS_ENV) $(BIN)/mkdocs build --strict --quiet
+	@echo "documentation: site/index.html"
+
 lint: setup  ## ruff and mypy --strict
-	$(BIN)/ruff check cosim models adapters studies tests bench
-	$(BIN)/mypy cosim models adapters
+	$(BIN)/ruff check cosim models adapters studies tests bench examples docs
+	$(BIN)/mypy cosim models adapters examples/labkit/labkit
 
 bench: setup  ## benchmarks -> bench/results.json
 	$(BIN)/python bench/run.py --out bench/results.json
@@ -94,5 +99,5 @@ study-nav: setup  ## navigation acceptance: 3 presets x 10 seeds x 300 s
 	$(BIN)/python studies/nav_acceptance.py --seeds 10 --duration-s 300 --workers 2
 
 clean:  ## remove the virtual environment, caches and run outputs
-	rm -rf $(VENV) runs .pytest_cache .mypy_cache .ruff_cache build *.egg-info
+	rm -rf $(VENV) runs site .pytest_cache .mypy_cache .ruff_cache build *.egg-info
 	find . -name __pycache__ -type d -prune -exec rm -rf {} +

@@ -31,7 +31,7 @@ from adapters.assignment.contract import (
     protocol_registry,
 )
 from adapters.assignment.settings import AssignmentConfig
-from adapters.assignment.tables import DtaRecords
+from adapters.assignment.tables import ASSIGNMENTS, DtaRecords
 from adapters.assignment.topics import (
     ASSIGNMENT,
     CLAIMS,
@@ -65,6 +65,7 @@ from cosim.core.messages import (
     TaskOrder,
     TaskSet,
 )
+from cosim.core.recorder import TableSpec
 from cosim.core.timebase import period_ns, s_to_ns
 from models.assignment.problem import AssignmentProblem
 from models.kinematics import FleetState
@@ -79,6 +80,8 @@ class DtaAdapter:
 
     name: ClassVar[str] = "dta"
     requires: ClassVar[tuple[str, ...]] = ("fleet", "network", "navigation", "task_source")
+    tables: ClassVar[tuple[TableSpec, ...]] = (ASSIGNMENTS,)
+    """The tables it writes (documented in the table reference)."""
 
     def __init__(self, run: RunContext) -> None:
         self.cfg = run.settings(AssignmentConfig)

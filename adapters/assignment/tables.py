@@ -20,21 +20,27 @@ from typing import Any
 import numpy as np
 
 from adapters.assignment.contract import ProtocolAgent
-from cosim.core.recorder import Recorder
+from cosim.core.recorder import Recorder, TableSpec
 from cosim.core.timebase import NS_PER_S
 from models.assignment.problem import AssignmentProblem, hungarian, objective
 
-ASSIGNMENT_COLUMNS = (
-    "epoch",
-    "t_s",
-    "robot",
-    "round",
-    "basis_changed",
-    "cost",
-    "converged",
-    "messages",
-    "bytes",
+ASSIGNMENTS = TableSpec(
+    "assignments",
+    "One row per protocol round of a robot that had not decided, or whose state changed.",
+    {
+        "epoch": "the epoch (the task set the round works on)",
+        "t_s": "when (s)",
+        "robot": "the robot",
+        "round": "the robot's rounds in this epoch so far",
+        "basis_changed": "whether the robot's protocol state changed in the round",
+        "cost": "the robot's view of the assignment's objective (m, big-M terms included)",
+        "converged": "whether the robot's protocol has decided",
+        "messages": "protocol messages the robot has sent in this epoch",
+        "bytes": "bytes of those messages",
+    },
+    categorical=("robot",),
 )
+ASSIGNMENT_COLUMNS = tuple(ASSIGNMENTS.columns)
 
 
 @dataclass
@@ -55,7 +61,7 @@ class DtaRecords:
     """The assignments table and the statistics behind the DTA summary."""
 
     def __init__(self, recorder: Recorder, names: list[str], *, compare: bool = True) -> None:
-        self.table = recorder.table("assignments", ASSIGNMENT_COLUMNS, categorical=("robot",))
+        self.table = recorder.table(ASSIGNMENTS)
         self.recorder = recorder
         self.names = names
         self.epochs: dict[int, _Epoch] = {}

@@ -20,6 +20,7 @@ import numpy as np
 
 from adapters.fleet.motion import FleetAdapter
 from cosim.core.adapter import RunContext
+from cosim.core.recorder import TableSpec
 from cosim.core.timebase import NS_PER_S
 from models.collision import CollisionChecker, OtherKind, Proximity
 from models.kinematics import FleetState, Motion
@@ -28,7 +29,20 @@ from models.world import Warehouse
 
 NEAR_MISS_M = 0.1
 """Clearance below which two things count as a near miss (m)."""
-COLLISION_COLUMNS = ("t_s", "robot", "other", "kind", "depth_m", "speed_mps")
+COLLISIONS = TableSpec(
+    "collisions",
+    "One row per new contact of a robot with anything (the robot is held, never passes through).",
+    {
+        "t_s": "when the contact began (s)",
+        "robot": "the robot",
+        "other": "what it touched: wall_i, shelf_i, another robot's name, a person's id",
+        "kind": "wall, shelf, robot, or the kind of a moving thing (person, forklift)",
+        "depth_m": "how far the step would have gone into it (m)",
+        "speed_mps": "the robot's commanded speed at the contact (m/s): 0 means it stood still",
+    },
+    categorical=("robot", "other", "kind"),
+)
+COLLISION_COLUMNS = tuple(COLLISIONS.columns)
 
 Pair = tuple[int, int, int]
 """(robot, kind, other) of a pair in contact or near each other."""
@@ -39,6 +53,8 @@ class CollisionsAdapter:
 
     name: ClassVar[str] = "collisions"
     requires: ClassVar[tuple[str, ...]] = ("world", "fleet")
+    tables: ClassVar[tuple[TableSpec, ...]] = (COLLISIONS,)
+    """The tables it writes (documented in the table reference)."""
 
     def __init__(self, run: RunContext) -> None:
         world = run.service(Warehouse)
@@ -49,9 +65,7 @@ class CollisionsAdapter:
         shelves = [f"shelf_{i}" for i in range(len(world.shelves))]
         self.static_names = walls + shelves
         self.static_kinds = ["wall"] * len(walls) + ["shelf"] * len(shelves)
-        self.table = run.recorder.table(
-            "collisions", COLLISION_COLUMNS, categorical=("robot", "other", "kind")
-        )
+        self.table = run.recorder.table(COLLISIONS)
         self.recorder = run.recorder
         self.contacts: set[Pair] = set()
         self.near: set[Pair] = set()

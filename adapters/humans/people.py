@@ -46,9 +46,10 @@ from adapters.humans.files import (
 )
 from adapters.humans.session import Movers, SumoSession
 from adapters.humans.settings import HumansConfig
-from adapters.humans.tables import HumanRecords
+from adapters.humans.tables import HUMANS, HumanRecords
 from cosim.core.adapter import RunContext
 from cosim.core.kernel import Stage
+from cosim.core.recorder import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns, s_to_ns
 from cosim.scenario.fields import model_problem
 from cosim.scenario.sections import RobotsConfig, ScenarioSection
@@ -95,6 +96,8 @@ class HumansAdapter:
 
     name: ClassVar[str] = "humans"
     requires: ClassVar[tuple[str, ...]] = ("world", "fleet")
+    tables: ClassVar[tuple[TableSpec, ...]] = (HUMANS,)
+    """The tables it writes (documented in the table reference)."""
 
     def __init__(self, run: RunContext) -> None:
         cfg = run.settings(HumansConfig)

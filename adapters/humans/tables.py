@@ -15,6 +15,7 @@ import numpy as np
 from adapters.humans.settings import HumansConfig
 from adapters.tasks.source import TaskSourceAdapter
 from cosim.core.adapter import RunContext
+from cosim.core.recorder import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns
 from models.humans.encounters import HALT_MPS, Encounters
 from models.kinematics import FleetState
@@ -23,7 +24,21 @@ from models.tasks.book import TaskStatus
 if TYPE_CHECKING:
     from adapters.humans.people import People
 
-HUMAN_COLUMNS = ("t_s", "id", "kind", "x_m", "y_m", "yaw_rad", "speed_mps")
+HUMANS = TableSpec(
+    "humans",
+    "Every person and forklift SUMO moves, sampled at humans.record_hz.",
+    {
+        "t_s": "sample time (s)",
+        "id": "SUMO's id of the person or vehicle",
+        "kind": "person or forklift",
+        "x_m": "position x in map (m)",
+        "y_m": "position y in map (m)",
+        "yaw_rad": "heading in map (rad)",
+        "speed_mps": "speed (m/s)",
+    },
+    categorical=("id", "kind"),
+)
+HUMAN_COLUMNS = tuple(HUMANS.columns)
 PEOPLE_KINDS = ("person", "forklift")
 
 
@@ -33,7 +48,7 @@ class HumanRecords:
     def __init__(self, run: RunContext, cfg: HumansConfig) -> None:
         self.fleet = run.service(FleetState)
         self.recorder = run.recorder
-        self.table = run.recorder.table("humans", HUMAN_COLUMNS, categorical=("id", "kind"))
+        self.table = run.recorder.table(HUMANS)
         self.encounters = Encounters(cfg.near_miss_m, cfg.stop_radius_m)
         self.record_ns = period_ns(cfg.record_hz)
         self.next_record_ns = 0

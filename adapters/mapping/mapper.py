@@ -27,7 +27,7 @@ import numpy as np
 
 from adapters.mapping.geometry import map_geometry
 from adapters.mapping.settings import MappingConfig
-from adapters.mapping.tables import MappingRecords
+from adapters.mapping.tables import MAP_MERGES, MAP_QUALITY, SCAN_MATCHES, MappingRecords
 from adapters.naming import topic
 from adapters.navigation.robots_layer import ROBOT_STATES
 from adapters.navigation.settings import NavigationConfig
@@ -46,6 +46,7 @@ from cosim.core.messages import (
     TFMessage,
     Transform,
 )
+from cosim.core.recorder import TableSpec
 from cosim.core.timebase import period_ns, s_to_ns
 from cosim.scenario.sections import LidarConfig, RobotsConfig
 from models.arrays import FloatArray
@@ -101,6 +102,8 @@ class MappingAdapter:
 
     name: ClassVar[str] = "mapping"
     requires: ClassVar[tuple[str, ...]] = ("world", "fleet", "lidar", "network")
+    tables: ClassVar[tuple[TableSpec, ...]] = (MAP_QUALITY, SCAN_MATCHES, MAP_MERGES)
+    """The tables it writes (documented in the table reference)."""
 
     def __init__(self, run: RunContext) -> None:
         self.cfg = run.settings(MappingConfig)

@@ -21,35 +21,61 @@ from typing import Any
 
 import numpy as np
 
-from cosim.core.recorder import Recorder
+from cosim.core.recorder import Recorder, TableSpec
 from cosim.core.timebase import NS_PER_S
 from models.mapping.grid import LogOddsMap, MapGeometry
 from models.mapping.quality import Int8Array, MapScores, map_scores, observable
 from models.occupancy import OccupancyGrid, rasterize_boxes
 from models.world import Warehouse
 
-QUALITY_COLUMNS = (
-    "t_s",
-    "robot",
-    "coverage",
-    "iou",
-    "accuracy",
-    "ate_m",
-    "ate_odom_m",
-    "iou_strict",
+MAP_QUALITY = TableSpec(
+    "map_quality",
+    "Every robot's map against the ground truth, and the fleet's (its maps fused), over time.",
+    {
+        "t_s": "when (s)",
+        "robot": "the robot, or fleet",
+        "coverage": "share of the observable cells the map knows (0-1)",
+        "iou": "occupied cells against the truth over the explored area, one cell of tolerance",
+        "accuracy": "share of the known cells right about free or occupied (0-1)",
+        "ate_m": "RMS of the pose estimate's position error so far (m)",
+        "ate_odom_m": "the same for odometry alone (m)",
+        "iou_strict": "iou without the cell of tolerance",
+    },
+    categorical=("robot",),
 )
-MATCH_COLUMNS = (
-    "t_s",
-    "robot",
-    "x_m",
-    "y_m",
-    "yaw_rad",
-    "error_m",
-    "odom_error_m",
-    "score",
-    "matched",
+QUALITY_COLUMNS = tuple(MAP_QUALITY.columns)
+SCAN_MATCHES = TableSpec(
+    "scan_matches",
+    "One row per map update of a robot: where scan matching put it, and how wrong that is.",
+    {
+        "t_s": "when (s)",
+        "robot": "the robot",
+        "x_m": "the pose estimate's x in map (m)",
+        "y_m": "its y in map (m)",
+        "yaw_rad": "its heading (rad)",
+        "error_m": "distance of the estimate from the true position (m)",
+        "odom_error_m": "distance of odometry alone from the true position (m)",
+        "score": "the match's score (share of the scan's points on occupied cells)",
+        "matched": "whether the match was accepted (else odometry was kept)",
+    },
+    categorical=("robot",),
 )
-MERGE_COLUMNS = ("t_s", "robot", "source", "kind", "bytes", "delay_s", "cells")
+MATCH_COLUMNS = tuple(SCAN_MATCHES.columns)
+MAP_MERGES = TableSpec(
+    "map_merges",
+    "One row per neighbour's scan or map a robot added to its own (mapping.share).",
+    {
+        "t_s": "when it was added (s)",
+        "robot": "the robot that added it",
+        "source": "the neighbour that sent it",
+        "kind": "scan or map",
+        "bytes": "its size on the wire (bytes)",
+        "delay_s": "time from sending to adding (s)",
+        "cells": "cells of the robot's map it changed",
+    },
+    categorical=("robot", "source", "kind"),
+)
+MERGE_COLUMNS = tuple(MAP_MERGES.columns)
 FLEET = "fleet"
 
 
@@ -71,11 +97,9 @@ class MappingRecords:
         self, recorder: Recorder, names: list[str], world: Warehouse, geometry: MapGeometry
     ) -> None:
         self.names = names
-        self.quality = recorder.table("map_quality", QUALITY_COLUMNS, categorical=("robot",))
-        self.matches = recorder.table("scan_matches", MATCH_COLUMNS, categorical=("robot",))
-        self.merges = recorder.table(
-            "map_merges", MERGE_COLUMNS, categorical=("robot", "source", "kind")
-        )
+        self.quality = recorder.table(MAP_QUALITY)
+        self.matches = recorder.table(SCAN_MATCHES)
+        self.merges = recorder.table(MAP_MERGES)
         x0, y0 = geometry.origin_xy_m
         r = geometry.resolution_m
         extent = (x0, y0, x0 + geometry.width * r, y0 + geometry.height * r)

@@ -27,13 +27,14 @@ import simpy
 from adapters.mocap.intake import PoseIntake
 from adapters.mocap.live import LiveSource, open_live_source
 from adapters.mocap.settings import MocapConfig
-from adapters.mocap.tables import MocapRecords
+from adapters.mocap.tables import MOCAP, MocapRecords
 from adapters.mocap.tracking import external_bodies, simulated_robots
 from adapters.mocap.tracks import PoseTrack, read_pose_track
 from cosim.core.adapter import RunContext
 from cosim.core.errors import ConfigError
 from cosim.core.hosts import HostKind
 from cosim.core.kernel import Stage
+from cosim.core.recorder import TableSpec
 from cosim.core.rng import BlockDraws
 from cosim.core.timebase import ms_to_ns, period_ns
 from models.kinematics import FleetState
@@ -47,6 +48,8 @@ class MocapAdapter:
 
     name: ClassVar[str] = "mocap"
     requires: ClassVar[tuple[str, ...]] = ("fleet",)
+    tables: ClassVar[tuple[TableSpec, ...]] = (MOCAP,)
+    """The tables it writes (documented in the table reference)."""
 
     def __init__(self, run: RunContext) -> None:
         self.cfg = cfg = run.settings(MocapConfig)

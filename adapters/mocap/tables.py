@@ -11,10 +11,21 @@ from collections import Counter
 from typing import Any
 
 from cosim.core.adapter import RunContext
-from cosim.core.recorder import Table
+from cosim.core.recorder import Table, TableSpec
 from cosim.core.timebase import NS_PER_S
 
-MOCAP_COLUMNS = ("t_s", "robot", "event", "detail")
+MOCAP = TableSpec(
+    "mocap",
+    "Measured poses rejected, and robots whose poses went stale or fresh again.",
+    {
+        "t_s": "when (s)",
+        "robot": "the robot",
+        "event": "jump, out_of_order or invalid (a pose rejected), stale or fresh",
+        "detail": "the particulars (the jump's size, the pose's age, ...)",
+    },
+    categorical=("robot", "event"),
+)
+MOCAP_COLUMNS = tuple(MOCAP.columns)
 
 EVENTS = ("jump", "out_of_order", "invalid", "stale", "fresh")
 """The events of ``tables/mocap``."""
@@ -27,9 +38,7 @@ class MocapRecords:
     """
 
     def __init__(self, run: RunContext) -> None:
-        self.table: Table = run.recorder.table(
-            "mocap", MOCAP_COLUMNS, categorical=("robot", "event")
-        )
+        self.table: Table = run.recorder.table(MOCAP)
         self.counts: Counter[str] = Counter()
         self._reported = False
 

@@ -45,7 +45,7 @@ from adapters.navigation.recovery import Recovery, StallWatch
 from adapters.navigation.robots_layer import RobotsLayer
 from adapters.navigation.scan_memory import MovingMemory, ScanMemory
 from adapters.navigation.settings import NavigationConfig
-from adapters.navigation.tables import NavRecords
+from adapters.navigation.tables import NAVIGATION, NavRecords
 from cosim.core.adapter import RunContext
 from cosim.core.bus import Envelope
 from cosim.core.errors import ConfigError
@@ -60,6 +60,7 @@ from cosim.core.messages import (
     Twist,
 )
 from cosim.core.messages import OccupancyGrid as GridMessage
+from cosim.core.recorder import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns, s_to_ns
 from cosim.scenario.model import Scenario
 from cosim.scenario.sections import LidarConfig, RobotsConfig
@@ -90,6 +91,8 @@ class NavigationAdapter:
 
     name: ClassVar[str] = "navigation"
     requires: ClassVar[tuple[str, ...]] = ("world", "fleet", "lidar")
+    tables: ClassVar[tuple[TableSpec, ...]] = (NAVIGATION,)
+    """The tables it writes (documented in the table reference)."""
 
     @staticmethod
     def check_scenario(scenario: Scenario) -> None:

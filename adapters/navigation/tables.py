@@ -13,19 +13,26 @@ from typing import Any
 import numpy as np
 
 from adapters.navigation.recovery import STUCK_KINDS
-from cosim.core.recorder import Recorder
+from cosim.core.recorder import Recorder, TableSpec
 from cosim.core.timebase import NS_PER_S
 
-NAV_COLUMNS = (
-    "t_s",
-    "robot",
-    "event",
-    "goal_x_m",
-    "goal_y_m",
-    "path_length_m",
-    "plan_ms",
-    "detail",
+NAVIGATION = TableSpec(
+    "navigation",
+    "One row per goal, plan, replan, recovery, stuck report, arrival and drop of every robot.",
+    {
+        "t_s": "when (s)",
+        "robot": "the robot",
+        "event": "goal, plan, replan, recovery, stuck, arrived, unreachable or cancelled",
+        "goal_x_m": "the goal's x in map (m)",
+        "goal_y_m": "the goal's y in map (m)",
+        "path_length_m": "plans: the length of the path found (m); empty otherwise",
+        "plan_ms": "plans: wall-clock time the planner took (ms; volatile)",
+        "detail": "how a plan was found (repaired, cleared), the recovery step, why stuck",
+    },
+    categorical=("robot", "event", "detail"),
+    volatile=("plan_ms",),
 )
+NAV_COLUMNS = tuple(NAVIGATION.columns)
 
 
 class NavRecords:
@@ -37,12 +44,7 @@ class NavRecords:
     """
 
     def __init__(self, recorder: Recorder, names: list[str]) -> None:
-        self.table = recorder.table(
-            "navigation",
-            NAV_COLUMNS,
-            categorical=("robot", "event", "detail"),
-            volatile=("plan_ms",),
-        )
+        self.table = recorder.table(NAVIGATION)
         self.recorder = recorder
         self.names = names
         n = len(names)

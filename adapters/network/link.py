@@ -24,13 +24,25 @@ from cosim.core.errors import ConfigError
 from cosim.core.hosts import HostId, HostKind
 from cosim.core.kernel import Stage
 from cosim.core.link import AllDelivered, DeliveryStatus, Transfer
+from cosim.core.recorder import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns
 from models.kinematics import FleetState
 from models.network.fate import Fate
 from models.network.model import NetworkModel, Partition
 from models.network.topology import Edges, edge
 
-LINK_COLUMNS = ("t_s", "a", "b", "up")
+LINKS = TableSpec(
+    "links",
+    "The links between hosts at t = 0, then every change (by range or partition).",
+    {
+        "t_s": "when (s)",
+        "a": "one host",
+        "b": "the other host",
+        "up": "whether the pair can reach each other from then on",
+    },
+    categorical=("a", "b"),
+)
+LINK_COLUMNS = tuple(LINKS.columns)
 _STATUS = {fate: DeliveryStatus(fate.value) for fate in Fate}
 
 
@@ -88,6 +100,8 @@ class NetworkAdapter:
 
     name: ClassVar[str] = "network"
     requires: ClassVar[tuple[str, ...]] = ("world", "fleet")
+    tables: ClassVar[tuple[TableSpec, ...]] = (LINKS,)
+    """The tables it writes (documented in the table reference)."""
 
     def __init__(self, run: RunContext) -> None:
         cfg = run.settings(NetworkConfig)
@@ -101,7 +115,7 @@ class NetworkAdapter:
         self.range_m = cfg.range_m if cfg.range_m > 0 else None
         self.link = NetworkLink(self.model, self._distance_m)
         run.bus.link = self.link
-        self.table = run.recorder.table("links", LINK_COLUMNS, categorical=("a", "b"))
+        self.table = run.recorder.table(LINKS)
         self.update_ns = period_ns(cfg.topology_update_hz)
         self._state: Edges = frozenset()
         self.changes = 0

@@ -12,11 +12,26 @@ from typing import Any, ClassVar
 
 from cosim.core.adapter import RunContext
 from cosim.core.kernel import Stage
+from cosim.core.recorder import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns
 from cosim.scenario.sections import RecordConfig
 from models.kinematics import FleetState
 
-POSE_COLUMNS = ("t_s", "robot", "x_m", "y_m", "yaw_rad", "v_mps", "w_radps")
+POSES = TableSpec(
+    "poses",
+    "Every robot's ground truth, sampled at record.pose_rate_hz.",
+    {
+        "t_s": "sample time (s)",
+        "robot": "the robot",
+        "x_m": "position x in map (m)",
+        "y_m": "position y in map (m)",
+        "yaw_rad": "heading in map (rad, counter-clockwise from x)",
+        "v_mps": "forward speed (m/s)",
+        "w_radps": "yaw rate (rad/s)",
+    },
+    categorical=("robot",),
+)
+POSE_COLUMNS = tuple(POSES.columns)
 
 
 class PosesAdapter:
@@ -24,10 +39,11 @@ class PosesAdapter:
 
     name: ClassVar[str] = "poses"
     requires: ClassVar[tuple[str, ...]] = ("fleet",)
+    tables: ClassVar[tuple[TableSpec, ...]] = (POSES,)
 
     def __init__(self, run: RunContext) -> None:
         self.fleet = run.service(FleetState)
-        self.table = run.recorder.table("poses", POSE_COLUMNS, categorical=("robot",))
+        self.table = run.recorder.table(POSES)
         self.period_ns = period_ns(run.settings(RecordConfig).pose_rate_hz)
         self._listeners: list[Callable[[int], None]] = []
         run.provide(self)

@@ -52,6 +52,7 @@ from cosim.core.messages import (
     TaskOrder,
     TaskSet,
 )
+from cosim.core.recorder import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns, s_to_ns
 from cosim.scenario.sections import RobotsConfig, WorldConfig
 from models.kinematics import FleetState
@@ -60,17 +61,23 @@ from models.tasks.book import ClaimOutcome, TaskBook, TaskStatus
 from models.tasks.stations import pick_stations
 from models.world import Warehouse
 
-TASK_COLUMNS = (
-    "task",
-    "x_m",
-    "y_m",
-    "t_created_s",
-    "t_assigned_s",
-    "robot",
-    "t_started_s",
-    "t_completed_s",
-    "reassignments",
+TASKS_TABLE = TableSpec(
+    "tasks",
+    "One row per task the source created, with its life: created, assigned, started, done.",
+    {
+        "task": "the task's id",
+        "x_m": "its pick station's x in map (m)",
+        "y_m": "its pick station's y in map (m)",
+        "t_created_s": "when it appeared (s)",
+        "t_assigned_s": "when a robot first claimed it (s); empty if never",
+        "robot": "the robot that served it (empty if none did)",
+        "t_started_s": "when the source granted that robot service, at the task (s)",
+        "t_completed_s": "when the robot reported it done (s); empty if not done",
+        "reassignments": "how often its claim passed from one robot to another",
+    },
+    categorical=("robot",),
 )
+TASK_COLUMNS = tuple(TASKS_TABLE.columns)
 ANNOUNCE_HZ = 5.0
 """How often the source checks whether a new epoch must be announced (Hz)."""
 
@@ -80,6 +87,8 @@ class TaskSourceAdapter:
 
     name: ClassVar[str] = "task_source"
     requires: ClassVar[tuple[str, ...]] = ("world", "fleet", "network", "navigation")
+    tables: ClassVar[tuple[TableSpec, ...]] = (TASKS_TABLE,)
+    """The tables it writes (documented in the table reference)."""
 
     def __init__(self, run: RunContext) -> None:
         self.cfg = run.settings(TasksConfig)
@@ -252,7 +261,7 @@ class TaskSourceAdapter:
     # -- records ---------------------------------------------------------------------------
     def finish(self, run: RunContext) -> Mapping[str, Any]:
         """The tasks table and the task metrics."""
-        table = run.recorder.table("tasks", TASK_COLUMNS, categorical=("robot",))
+        table = run.recorder.table(TASKS_TABLE)
         completed = []
         for task in sorted(self.book.tasks.values(), key=lambda t: t.task_id):
             table.append(

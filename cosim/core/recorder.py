@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from array import array
 from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any, Protocol
 
 import numpy as np
@@ -45,6 +46,30 @@ class MapArtifact(Protocol):
     def data(self) -> npt.NDArray[np.int8]:
         """The cells."""
         ...
+
+
+@dataclass(frozen=True)
+class TableSpec:
+    """A table a run writes (``tables/NAME.parquet``), with what each column means.
+
+    Every table is declared once, with its columns' meanings, so that the documentation's
+    table reference is generated from the code that writes the tables. Units are in the
+    column names (``t_s``, ``x_m``, ``yaw_rad``, ``bytes``); positions are in ``map``.
+
+    Attributes:
+        name: the table's name.
+        doc: one line: what a row is.
+        columns: column -> its meaning, in output order.
+        categorical: columns of repeated strings (written as ``category``).
+        volatile: wall-clock columns: the only values that are not a function of the
+            scenario and seed (comparisons of runs leave them out).
+    """
+
+    name: str
+    doc: str
+    columns: Mapping[str, str]
+    categorical: tuple[str, ...] = ()
+    volatile: tuple[str, ...] = ()
 
 
 class _Interner:
@@ -131,18 +156,36 @@ class Table:
         return pd.DataFrame(columns, columns=self.columns)
 
 
-MESSAGE_COLUMNS = (
-    "t_sent_s",
-    "t_recv_s",
-    "src_host",
-    "dst_host",
-    "topic",
-    "bytes",
-    "status",
-    "t_sent_ns",
-    "t_recv_ns",
+MESSAGES = TableSpec(
+    "messages",
+    "One row per message and destination host: every send over the bus, its fate and size.",
+    {
+        "t_sent_s": "when the message was published (s)",
+        "t_recv_s": "when it was delivered (s); empty when dropped",
+        "src_host": "the publishing host (a robot's name, or base)",
+        "dst_host": "the receiving host",
+        "topic": "the topic",
+        "bytes": "its size on the wire: CDR body and encapsulation header (bytes)",
+        "status": "delivered, or why not: lost, queue_full, out_of_range or partitioned",
+        "t_sent_ns": "t_sent_s in exact integer nanoseconds",
+        "t_recv_ns": "t_recv_s in exact integer nanoseconds; empty when dropped",
+    },
+    categorical=("src_host", "dst_host", "topic", "status"),
 )
-EVENT_COLUMNS = ("t_s", "source", "kind", "detail", "t_ns")
+EVENTS = TableSpec(
+    "events",
+    "One row per discrete event any component records (goals, arrivals, tasks, contacts, ...).",
+    {
+        "t_s": "when (s)",
+        "source": "the component that recorded it (an adapter's name)",
+        "kind": "what happened, a short verb or noun (built, task, done, conflict, ...)",
+        "detail": "the particulars, in words",
+        "t_ns": "t_s in exact integer nanoseconds",
+    },
+    categorical=("source", "kind"),
+)
+MESSAGE_COLUMNS = tuple(MESSAGES.columns)
+EVENT_COLUMNS = tuple(EVENTS.columns)
 
 
 _FLUSH_ROWS = 65_536
@@ -175,6 +218,7 @@ class Recorder:
         self._chunks: list[dict[str, npt.NDArray[Any]]] = []
         self._events = Table(("t_ns", "source", "kind", "detail"))
         self.tables: dict[str, Table] = {}
+        self.specs: dict[str, TableSpec] = {}
         self.volatile: dict[str, tuple[str, ...]] = {}
         self.maps: dict[str, MapArtifact] = {}
         self.files: dict[str, bytes] = {}
@@ -316,22 +360,28 @@ class Recorder:
 
     def table(
         self,
-        name: str,
-        columns: Sequence[str],
+        name: str | TableSpec,
+        columns: Sequence[str] = (),
         categorical: Iterable[str] = (),
         *,
         volatile: Iterable[str] = (),
     ) -> Table:
-        """Create (once) and return the table ``name``; it is exported as ``tables/NAME``.
+        """Create (once) and return a table; it is exported as ``tables/NAME``.
 
         Args:
-            name: table name.
-            columns: column names, in order.
-            categorical: columns of repeated strings.
+            name: the table's :class:`TableSpec` (its columns documented), or its name.
+            columns: column names, in order (with a name).
+            categorical: columns of repeated strings (with a name).
             volatile: wall-clock columns (e.g. a planning time in ms): the only values
                 that are not a function of the scenario and seed; comparisons of runs
-                leave them out (see :attr:`volatile`).
+                leave them out (see :attr:`volatile`). With a name.
         """
+        if isinstance(name, TableSpec):
+            spec = name
+            self.specs[spec.name] = spec
+            return self.table(
+                spec.name, tuple(spec.columns), spec.categorical, volatile=spec.volatile
+            )
         if name in self.tables or name in ("messages", "events"):
             raise ValueError(f"table {name!r} exists already")
         table = Table(columns, categorical)

@@ -19,7 +19,7 @@ from adapters.world.files import write_map
 from cosim.core.adapter import AdapterType
 from cosim.core.errors import ExportError, RegistryError
 from cosim.core.kernel import Lateness
-from cosim.core.recorder import MapArtifact, Recorder, merge_counts
+from cosim.core.recorder import MapArtifact, Recorder, TableSpec, merge_counts
 from cosim.core.registry import AdapterRegistry
 from cosim.core.timebase import NS_PER_S, s_to_ns
 from cosim.recording.foxglove import LiveOptions
@@ -211,6 +211,18 @@ def _run_assembled(
     )
 
 
+REALTIME = TableSpec(
+    "realtime",
+    "Real-time runs only: one row per batch of events due at one simulated instant.",
+    {
+        "t_s": "the batch's simulated instant (s)",
+        "lateness_ms": "wall-clock time past the instant it was due (ms; volatile)",
+        "events": "events processed in the batch",
+    },
+    volatile=("lateness_ms",),
+)
+
+
 def record_lateness(lateness: Lateness, recorder: Recorder) -> dict[str, Any]:
     """Write ``tables/realtime`` (one row per event batch) and return the summary keys.
 
@@ -218,7 +230,7 @@ def record_lateness(lateness: Lateness, recorder: Recorder) -> dict[str, Any]:
     instant it was due), events (in the batch). Wall-clock figures: volatile.
     """
     late_ms = np.frombuffer(lateness.late_ns, dtype=np.int64) / 1e6
-    table = recorder.table("realtime", ("t_s", "lateness_ms", "events"), volatile=("lateness_ms",))
+    table = recorder.table(REALTIME)
     table.extend(
         t_s=np.frombuffer(lateness.t_ns, dtype=np.int64) / NS_PER_S,
         lateness_ms=late_ms,
@@ -300,12 +312,12 @@ def run(
 ) -> RunResult:
     """Run a scenario; optionally write its folder.
 
-    ::
-
-        import cosim
-        scenario = cosim.load_scenario("warehouse-random", overrides={"robots.count": 8})
-        result = cosim.run(scenario, seed=3, adapters=[MySensorAdapter])
-        result.tables["poses"].groupby("robot").v_mps.mean()
+    ```python
+    import cosim
+    scenario = cosim.load_scenario("warehouse-random", overrides={"robots.count": 8})
+    result = cosim.run(scenario, seed=3, adapters=[MySensorAdapter])
+    result.tables["poses"].groupby("robot").v_mps.mean()
+    ```
 
     Args:
         scenario: from :func:`cosim.load_scenario`.

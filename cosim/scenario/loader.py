@@ -185,7 +185,8 @@ def _apply_profile(
     return merged, merged_origins
 
 
-def _toml_value(value: Any) -> str:
+def toml_value(value: Any) -> str:
+    """A value as TOML text (the resolved scenario's, and the key reference's defaults)."""
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, int):
@@ -197,11 +198,9 @@ def _toml_value(value: Any) -> str:
     if isinstance(value, str):
         return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
     if isinstance(value, list | tuple):
-        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+        return "[" + ", ".join(toml_value(v) for v in value) + "]"
     if is_dataclass(value) and not isinstance(value, type):
-        inner = ", ".join(
-            f"{f.name} = {_toml_value(getattr(value, f.name))}" for f in fields(value)
-        )
+        inner = ", ".join(f"{f.name} = {toml_value(getattr(value, f.name))}" for f in fields(value))
         return "{" + inner + "}"
     raise TypeError(f"cannot write {type(value).__name__} to TOML")
 
@@ -216,7 +215,7 @@ def dump_scenario(scenario: Scenario) -> str:
         lines.append("")
         lines.append(f"[{name}]")
         for f in fields(section):
-            lines.append(f"{f.name} = {_toml_value(getattr(section, f.name))}")
+            lines.append(f"{f.name} = {toml_value(getattr(section, f.name))}")
     return "\n".join(lines) + "\n"
 
 

@@ -10,6 +10,7 @@ it by name (untyped).
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Collection, Iterator, Mapping
 from dataclasses import dataclass, field, replace
 from types import MappingProxyType
@@ -83,18 +84,34 @@ class Scenario:
     def section(self, kind: type[S]) -> S:
         """The section of type ``kind``.
 
+        A section type that no installed package registers (the settings of an adapter given
+        to :func:`cosim.run` in code) reads as its defaults.
+
         Raises:
-            RegistryError: if no section of the scenario has that type (its package is not
-                installed, or does not register it in ``cosim.sections``).
+            RegistryError: for a registered section missing from the scenario.
         """
         found = self._by_type.get(kind)
         if found is None:
-            raise RegistryError(
-                f"{self.source}: no section of type {kind.__name__}: register it in the "
-                "cosim.sections entry-point group (registered here: "
-                f"{', '.join(self.sections)})"
-            )
+            return self._unregistered(kind)
         return found  # type: ignore[no-any-return]
+
+    def _unregistered(self, kind: type[S]) -> S:
+        """The defaults of a section no installed package registers (an adapter given in code).
+
+        No scenario file could have set its keys (an unregistered section is refused when
+        loading), so its defaults are its values. A registered section missing here (its
+        package broke after the scenario was loaded) is an error.
+        """
+        registered = any(kind is cls for cls in section_classes().values())
+        if registered or not dataclasses.is_dataclass(kind):
+            raise RegistryError(
+                f"{self.source}: no section of type {kind.__name__} in this scenario (its "
+                f"sections: {', '.join(self.sections)}); register it in the cosim.sections "
+                "entry-point group"
+            )
+        defaults = kind()
+        self._by_type[kind] = defaults  # type: ignore[index]
+        return defaults
 
     def __getattr__(self, name: str) -> Any:
         if name.startswith("__"):

@@ -21,6 +21,7 @@ from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from adapters.assignment.contract import EpochView, ProtocolAgent, ProtocolBase, ProtocolFleet
 from cosim.core.messages import Message
 from cosim.scenario.fields import param
+from models.arrays import FloatArray
 
 BID_TABLE = "labkit_msgs/msg/BidTable"
 BID_TABLE_MSG = """builtin_interfaces/Time stamp
@@ -95,7 +96,7 @@ class AuctionAgent:
         self.epoch = epoch
         self.patience = patience
         self.order = order
-        self.bids = np.full(epoch.problem.cost.shape, np.inf)
+        self.bids: FloatArray = np.full(epoch.problem.cost.shape, np.inf)
         self.bids[epoch.robot] = epoch.problem.cost[epoch.robot]
         self.quiet = 0
         self._rounds = 0

@@ -23,6 +23,7 @@ from cosim.core.bus import TopicQos
 from cosim.core.hosts import HostId
 from cosim.core.kernel import Stage
 from cosim.core.messages import Message
+from cosim.core.recorder import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns
 from cosim.scenario.fields import param
 from models.kinematics import FleetState
@@ -32,6 +33,17 @@ from models.world import Warehouse
 
 ULTRASOUND = 0
 """``sensor_msgs/Range.radiation_type`` of an ultrasonic sensor."""
+
+RANGES = TableSpec(
+    "ranges",
+    "Every robot's range finder reading.",
+    {
+        "t_s": "reading time (s)",
+        "robot": "the robot",
+        "range_m": "distance to the nearest surface ahead (m); inf with nothing in range",
+    },
+    categorical=("robot",),
+)
 
 
 @dataclass(frozen=True)
@@ -93,6 +105,7 @@ class RangeFinderAdapter:
 
     name: ClassVar[str] = "rangefinder"
     requires: ClassVar[tuple[str, ...]] = ("world", "fleet")
+    tables: ClassVar[tuple[TableSpec, ...]] = (RANGES,)
 
     def __init__(self, run: RunContext) -> None:
         self.settings = run.settings(RangeFinderSettings)
@@ -106,9 +119,7 @@ class RangeFinderAdapter:
         self.topics = [f"/{name}/range" for name in names]
         self.frames = [f"{name}/range" for name in names]
         self.hosts = [HostId(name) for name in names]
-        self.table = run.recorder.table(
-            "ranges", ("t_s", "robot", "range_m"), categorical=("robot",)
-        )
+        self.table = run.recorder.table(RANGES)
         self.readings = 0
         for name in self.topics:
             run.bus.advertise(name, Range, TopicQos.SENSOR)

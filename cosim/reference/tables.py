@@ -1,0 +1,77 @@
+"""The table reference: every table a run can write, with what each column means."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from cosim.core.recorder import EVENTS, MESSAGES, TableSpec
+from cosim.core.registry import AdapterRegistry
+from cosim.runner.execute import REALTIME
+
+
+@dataclass(frozen=True)
+class DocumentedTable:
+    """A table and who writes it.
+
+    Attributes:
+        spec: the table's declaration.
+        writer: what writes it (``the recorder``, ``adapter navigation``, ...).
+        package: the package that registers the writer.
+    """
+
+    spec: TableSpec
+    writer: str
+    package: str
+
+
+def documented_tables() -> list[DocumentedTable]:
+    """The recorder's tables, the real-time table, and every loadable adapter's ``tables``."""
+    found = [
+        DocumentedTable(
+            MESSAGES, "the recorder (every run, unless record.messages = false)", "cosim"
+        ),
+        DocumentedTable(EVENTS, "the recorder (every run)", "cosim"),
+        DocumentedTable(REALTIME, "the runner (real-time runs)", "cosim"),
+    ]
+    registry = AdapterRegistry.from_entry_points()
+    for name, adapter in registry.load_all().items():
+        for spec in getattr(adapter, "tables", ()):
+            found.append(DocumentedTable(spec, f"adapter `{name}`", registry.package(name)))
+    return found
+
+
+def tables_markdown() -> str:
+    """The whole table reference page."""
+    lines = [
+        "# Tables",
+        "",
+        "A run writes its tables into `tables/NAME.parquet` of its folder (unless "
+        "`record.tables = false`); `cosim.run` returns them as pandas DataFrames in "
+        "`result.tables`. Units are in the column names (`t_s`, `x_m`, `yaw_rad`, "
+        "`bytes`); positions are in the `map` frame. Columns marked *category* hold "
+        "repeated strings (pandas `category`); *volatile* ones are wall-clock figures, the "
+        "only values that differ between two runs of the same scenario and seed.",
+        "",
+        "This page is generated from the tables' declarations (`TableSpec`, "
+        "`cosim/reference/tables.py`).",
+        "",
+    ]
+    for table in documented_tables():
+        spec = table.spec
+        lines += [
+            f"## `{spec.name}`",
+            "",
+            spec.doc,
+            "",
+            f"*Written by {table.writer}, package `{table.package}`.*",
+            "",
+            "| column | meaning |",
+            "|---|---|",
+        ]
+        for column, meaning in spec.columns.items():
+            marks = [m for m, on in (("category", column in spec.categorical),
+                                     ("volatile", column in spec.volatile)) if on]  # fmt: skip
+            note = f" *({', '.join(marks)})*" if marks else ""
+            lines.append(f"| `{column}` | {meaning.replace('|', '/')}{note} |")
+        lines.append("")
+    return "\n".join(lines) + "\n"

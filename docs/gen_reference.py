@@ -1,0 +1,19 @@
+"""Write the generated reference pages into the site (run by the mkdocs-gen-files plugin)."""
+
+import mkdocs_gen_files
+
+from cosim.reference.commands import commands_markdown
+from cosim.reference.keys import keys_markdown
+from cosim.reference.registries import registries_markdown
+from cosim.reference.tables import tables_markdown
+
+PAGES = {
+    "reference/scenario-keys.md": keys_markdown,
+    "reference/tables.md": tables_markdown,
+    "reference/cli.md": commands_markdown,
+    "reference/registries.md": registries_markdown,
+}
+
+for path, make in PAGES.items():
+    with mkdocs_gen_files.open(path, "w") as page:
+        page.write(make())

@@ -1,0 +1,57 @@
+"""The documentation site builds, strictly, and shows what the references promise."""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from tests.conftest import REPO, cosim_main
+
+pytestmark = pytest.mark.slow
+
+
+@pytest.fixture(scope="module")
+def site(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    out = tmp_path_factory.mktemp("site")
+    env = {**os.environ, "NO_MKDOCS_2_WARNING": "1", "DISABLE_MKDOCS_2_WARNING": "true"}
+    mkdocs = Path(sys.executable).parent / "mkdocs"
+    done = subprocess.run(
+        [str(mkdocs), "build", "--strict", "--quiet", "--site-dir", str(out)],
+        cwd=REPO, capture_output=True, text=True, env=env, timeout=300,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stdout + done.stderr
+    return out
+
+
+def test_the_site_has_every_page_of_the_navigation(site):
+    for page in (
+        "index.html",
+        "getting-started.html",
+        "concepts/kernel.html",
+        "concepts/architecture.html",
+        "tutorials/write-a-protocol.html",
+        "reference/scenario-keys.html",
+        "reference/tables.html",
+        "reference/cli.html",
+        "reference/api.html",
+        "reference/registries.html",
+    ):
+        assert (site / page).is_file(), page
+
+
+def test_every_key_of_the_humans_scenario_appears_in_the_built_site(site):
+    printed = cosim_main("check", "warehouse-humans", "--print").stdout
+    html = (site / "reference" / "scenario-keys.html").read_text()
+    for key in re.findall(r"^(\w+) = ", printed, flags=re.M):
+        assert f"<code>{key}</code>" in html, key
+
+
+def test_the_api_reference_renders_the_run_function_and_the_contracts(site):
+    html = (site / "reference" / "api.html").read_text()
+    for name in ("cosim.run", "RunContext", "ProtocolFleet", "ControlInputs", "TableSpec"):
+        assert name in html, name
