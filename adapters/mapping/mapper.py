@@ -48,7 +48,7 @@ from cosim.core.messages import (
 )
 from cosim.core.recorder import TableSpec
 from cosim.core.timebase import period_ns, s_to_ns
-from cosim.scenario.sections import LidarConfig, RobotsConfig
+from cosim.scenario.sections import LidarConfig
 from models.arrays import FloatArray
 from models.errors import ModelError
 from models.kinematics import FleetState
@@ -143,11 +143,9 @@ class MappingAdapter:
         self.recorder = run.recorder
         nav = run.settings(NavigationConfig)
         # with a robots layer each robot hears where the others are: returns off them are
-        # left out of its map and its matching (robots are not the building)
-        self.robots_layer = nav.robots_layer and run.settings(RobotsConfig).driver in (
-            "navigation",
-            "tasks",
-        )
+        # left out of its map and its matching (robots are not the building); whether one
+        # runs is known once every adapter is built (the navigation advertises it)
+        self.robots_layer = nav.robots_layer
         self.others: list[dict[str, tuple[float, float, float, int]]] = [{} for _ in self.names]
         self.others_timeout_ns = s_to_ns(nav.robots_layer_timeout_s)
 
@@ -155,6 +153,7 @@ class MappingAdapter:
     def start(self, run: RunContext) -> None:
         """Follow every robot's odometry and scans; start publishing and sampling."""
         bus = run.bus
+        self.robots_layer = self.robots_layer and ROBOT_STATES in bus.advertised()
         for i, (name, host) in enumerate(zip(self.names, self.hosts, strict=True)):
             bus.subscribe(topic(name, "odom"), host, self._on_odom(i))
             bus.subscribe(topic(name, "scan"), host, self._on_scan(run, i))

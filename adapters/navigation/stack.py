@@ -79,9 +79,6 @@ from models.navigation.traffic import (
 
 HALT_MPS = 0.02
 """Commanded speed below which a robot with a goal counts as halted (m/s)..."""
-LANE_WIDTH_M = 2.5
-"""``traffic = "lanes"`` and ``"pibt"``: aisles up to this wide are one-way (m); two robots
-pass in wider."""
 HALT_RADPS = 0.05
 """...when it does not turn faster than this either (rad/s)."""
 
