@@ -10,7 +10,8 @@ STUDIES := runs/studies
 STUDY = $(BIN)/cosim study studies/$(1).toml --out $(STUDIES)/$(1) --resume
 
 .PHONY: setup demo test test-fast docs lint bench clean help reproduce study-comm study-comm-reduced \
-	study-burst study-scale study-paper study-nav study-mapping study-mapping-reduced map-aces \
+	study-burst study-scale study-paper study-nav study-mapping study-mapping-reduced \
+	study-mapping-acceptance study-mapping-drift map-aces map-fr079 \
 	lab-real lab-mixed study-humans study-humans-reduced study-traffic
 
 help:  ## list the targets
@@ -82,6 +83,9 @@ study-mapping: setup  ## map sharing: bandwidth x loss x share mode, 5 seeds x 3
 study-mapping-reduced: setup  ## map sharing reduced to 12 runs x 120 s
 	$(call STUDY,map_sharing_reduced)
 
+study-mapping-acceptance: setup  ## the warehouse mapping acceptance: 10 seeds x 300 s, matching vs odometry (about 3 min)
+	$(call STUDY,mapping_acceptance)
+
 study-traffic: setup  ## traffic policies 'none', 'lanes', 'pibt' x 25/50 robots, 10 seeds x 300 s (about 7 min)
 	$(call STUDY,traffic)
 
@@ -92,8 +96,15 @@ study-humans-reduced: setup  ## robots among 0 or 10 workers, 2 seeds x 60 s
 	$(call STUDY,humans_reduced)
 
 ACES ?= ../shared/data/aces_lidar
+FR079 ?= ../shared/data/fr079_lidar
 map-aces: setup  ## map the ACES building's recording (needs ../shared/data) into runs/aces
 	$(BIN)/cosim map $(ACES) --out runs/aces --reference /ground_truth --force
+
+study-mapping-drift: setup  ## mapping on 30 drift realizations of each shared building, with and without loop closure (about 6 min)
+	$(BIN)/python studies/mapping_drift.py --seeds 30 --workers 2
+
+map-fr079: setup  ## map Freiburg building 079's recording (needs ../shared/data) into runs/fr079
+	$(BIN)/cosim map $(FR079) --out runs/fr079 --reference /ground_truth --force
 
 study-nav: setup  ## navigation acceptance: 3 presets x 10 seeds x 300 s
 	$(BIN)/python studies/nav_acceptance.py --seeds 10 --duration-s 300 --workers 2

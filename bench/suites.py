@@ -13,7 +13,7 @@ from dwa_bench import dwa_us_per_robot
 from humans_bench import humans_coupling
 from landmarks_bench import landmark_savings
 from lidar_bench import lidar_rays_per_second
-from mapping_bench import aces_mapping, fleet50_mapping, per_scan_costs
+from mapping_bench import fleet50_mapping, per_scan_costs, recordings_mapping
 from network_bench import network_deliveries_per_second
 from planner_bench import planner_ms
 from recording_bench import bag_cost, bag_memory_1h, encoding
@@ -430,6 +430,6 @@ SUITES: dict[str, Callable[[int], Result]] = {
     "cdr_encoding": encoding,
     "mapping_per_scan": per_scan_costs,
     "fleet50_mapping": fleet50_mapping,
-    "aces_mapping": aces_mapping,
+    "recordings_mapping": recordings_mapping,
     "humans_coupling": humans_coupling,
 }

@@ -148,25 +148,46 @@ def check_topics(
     return sorted({topic for _, topic, _ in wanted})
 
 
-def map_recording(
+@dataclass(frozen=True)
+class Recording:
+    """A recording's scans with the odometry (and reference) at each one's stamp.
+
+    Attributes:
+        bag: where it was read from.
+        stamps_ns: (scans,) each scan's stamp (ns), increasing.
+        ranges_m: (scans, beams) the ranges (m).
+        angles_rad: (beams,) the beams' angles in the sensor frame (rad).
+        range_min_m: shorter readings are invalid (m).
+        range_max_m: the lidar's maximum range (m).
+        odometry: (scans, 3) x m, y m, yaw rad (frame ``odom``), interpolated.
+        reference: (scans, 3) the reference pose at each scan, NaN outside it; None
+            without a reference topic.
+        skipped: scans outside the odometry's time span, left out.
+    """
+
+    bag: Path
+    stamps_ns: npt.NDArray[np.int64] = field(repr=False)
+    ranges_m: npt.NDArray[np.float32] = field(repr=False)
+    angles_rad: npt.NDArray[np.float64] = field(repr=False)
+    range_min_m: float
+    range_max_m: float
+    odometry: npt.NDArray[np.float64] = field(repr=False)
+    reference: npt.NDArray[np.float64] | None = field(repr=False)
+    skipped: int
+
+
+def read_recording(
     bag: Path,
     *,
     scan_topic: str = "/scan",
     odom_topic: str = "/odom",
     reference_topic: str | None = None,
-    resolution_m: float = 0.05,
-    gate: UpdateGate | None = None,
-    matcher: MatcherParams | None = None,
-    scan_matching: bool = True,
-    loop_closure: bool = True,
-    clear_no_return_m: float = 3.0,
-    progress: Progress | None = None,
-) -> RecordingMap:
-    """Map a recorded bag.
+) -> Recording:
+    """A bag's scans, each with the odometry (and reference) interpolated at its stamp.
 
     Raises:
-        BagError: not a bag, a topic missing or of the wrong type, no scan that odometry
-            covers.
+        BagError: not a bag, a topic missing or of the wrong type, scans of different
+            sizes, no scan that odometry covers.
     """
     bag = Path(bag)
     topics = check_topics(bag, scan_topic, odom_topic, reference_topic)
@@ -183,50 +204,180 @@ def map_recording(
             f"{bag}: no scan on {scan_topic} falls within the odometry on {odom_topic} "
             "(their stamps do not overlap)"
         )
-    first = usable[0][1]
-    assert first is not None
     scan0 = usable[0][0].message
-    range_max = float(scan0.range_max)
-    lo, hi = odom.xyyaw[:, :2].min(axis=0), odom.xyyaw[:, :2].max(axis=0)
-    reach = min(range_max, MAP_REACH_M)
+    angles = scan0.angle_min + scan0.angle_increment * np.arange(len(scan0.ranges))
+    ranges = np.zeros((len(usable), len(angles)), dtype=np.float32)
+    for n, (scan, _) in enumerate(usable):
+        beams = np.asarray(scan.message.ranges, dtype=np.float32)
+        if len(beams) != len(angles):
+            raise BagError(
+                f"{bag}: {scan_topic} scan {n} has {len(beams)} beams; expected "
+                f"{len(angles)} like the first (one lidar per topic)"
+            )
+        ranges[n] = beams
+    stamps = np.array([_stamp_ns(s) for s, _ in usable], dtype=np.int64)
+    at_reference = None
+    if reference is not None:
+        nowhere = (math.nan, math.nan, math.nan)
+        at_reference = np.array([reference.at(int(t)) or nowhere for t in stamps])
+    return Recording(
+        bag,
+        stamps,
+        ranges,
+        np.asarray(angles, dtype=np.float64),
+        float(scan0.range_min),
+        float(scan0.range_max),
+        np.array([o for _, o in usable], dtype=np.float64),
+        at_reference,
+        len(scans) - len(usable),
+    )
+
+
+def map_recording(
+    bag: Path,
+    *,
+    scan_topic: str = "/scan",
+    odom_topic: str = "/odom",
+    reference_topic: str | None = None,
+    resolution_m: float = 0.05,
+    gate: UpdateGate | None = None,
+    matcher: MatcherParams | None = None,
+    scan_matching: bool = True,
+    loop_closure: bool = True,
+    clear_no_return_m: float = 3.0,
+    progress: Progress | None = None,
+) -> RecordingMap:
+    """Map a recorded bag: :func:`read_recording`, then :func:`map_scans`.
+
+    Raises:
+        BagError: not a bag, a topic missing or of the wrong type, no scan that odometry
+            covers.
+    """
+    recording = read_recording(
+        bag, scan_topic=scan_topic, odom_topic=odom_topic, reference_topic=reference_topic
+    )
+    mapped = map_scans(
+        recording.stamps_ns,
+        recording.ranges_m,
+        recording.odometry,
+        recording.angles_rad,
+        range_min_m=recording.range_min_m,
+        range_max_m=recording.range_max_m,
+        resolution_m=resolution_m,
+        gate=gate,
+        matcher=matcher,
+        scan_matching=scan_matching,
+        loop_closure=loop_closure,
+        clear_no_return_m=clear_no_return_m,
+        progress=progress,
+    )
+    return _result(recording, mapped)
+
+
+@dataclass
+class MappedScans:
+    """Scans mapped, before any reference is compared.
+
+    Attributes:
+        grid: the map built (frame ``map``: the odometry frame at the first scan).
+        rows: per scan (t_ns, estimated x m, y m, yaw rad, odometry x m, y m, yaw rad,
+            the pose graph's node it belongs to or -1); after loop closure, the estimate
+            is the final graph's.
+        mapper: the mapper, with its counts and pose graph.
+        wall_s: the processing time (s).
+        span_s: the scans' time span (s).
+    """
+
+    grid: LogOddsMap = field(repr=False)
+    rows: list[tuple[float, ...]] = field(repr=False)
+    mapper: ScanMapper = field(repr=False)
+    wall_s: float
+    span_s: float
+
+    def estimate_xy_m(self) -> npt.NDArray[np.float64]:
+        """(scans, 2) the estimated positions (m, ``map``)."""
+        return np.array([row[1:3] for row in self.rows], dtype=np.float64).reshape(-1, 2)
+
+
+def map_scans(
+    stamps_ns: npt.ArrayLike,
+    ranges: npt.ArrayLike,
+    odometry: npt.ArrayLike,
+    angles_rad: npt.ArrayLike,
+    *,
+    range_min_m: float,
+    range_max_m: float,
+    resolution_m: float = 0.05,
+    gate: UpdateGate | None = None,
+    matcher: MatcherParams | None = None,
+    scan_matching: bool = True,
+    loop_closure: bool | LoopParams = True,
+    clear_no_return_m: float = 3.0,
+    progress: Progress | None = None,
+) -> MappedScans:
+    """Map scans given with the odometry at each one's stamp: what ``cosim map`` does to a bag.
+
+    Args:
+        stamps_ns: (scans,) each scan's time (ns), increasing.
+        ranges: (scans, beams) each scan's ranges (m).
+        odometry: (scans, 3) the odometry pose (x m, y m, yaw rad; frame ``odom``) at
+            each scan.
+        angles_rad: (beams,) the beams' angles in the sensor frame (rad).
+        range_min_m: shorter readings are invalid (m).
+        range_max_m: the lidar's maximum range (m): readings at it are no return (REP 117).
+        resolution_m: the map's cell size (m).
+        gate: when a scan updates the map (default: slam_toolbox's).
+        matcher: the scan-to-map matcher's settings.
+        scan_matching: False keeps odometry only.
+        loop_closure: True for :class:`~models.mapping.loops.LoopParams`' defaults, False
+            for none, or the settings to use (needs scan matching).
+        clear_no_return_m: beams without a return clear the map up to this far (m).
+        progress: called every 20 scans with (time processed s, span s, wall s).
+    """
+    stamps = np.asarray(stamps_ns, dtype=np.int64).reshape(-1)
+    scans = np.asarray(ranges, dtype=np.float32)
+    poses = np.asarray(odometry, dtype=np.float64).reshape(-1, 3)
+    angles = np.asarray(angles_rad, dtype=np.float64).reshape(-1)
+    if not len(stamps) == len(scans) == len(poses) > 0 or scans.shape[1:] != angles.shape:
+        raise ValueError(
+            f"{len(stamps)} stamps, ranges of shape {scans.shape}, {len(poses)} odometry poses "
+            f"and {len(angles)} angles; expected as many stamps, scans and poses (at least "
+            "one) and a range per angle"
+        )
+    xy = poses[:, :2]
+    lo, hi = xy.min(axis=0), xy.max(axis=0)
+    reach = min(range_max_m, MAP_REACH_M)
     geometry = MapGeometry.covering((lo[0], lo[1], hi[0], hi[1]), resolution_m, reach)
     grid = LogOddsMap(geometry)
+    loops = LoopParams() if loop_closure is True else (loop_closure or None)
     params = MapperParams(
         gate=gate or UpdateGate(),
         matcher=matcher or MatcherParams(),
         scan_matching=scan_matching,
-        range_min_m=float(scan0.range_min),
-        range_max_m=range_max * 0.999,  # readings at the maximum are no return (REP 117)
+        range_min_m=range_min_m,
+        range_max_m=range_max_m * 0.999,  # readings at the maximum are no return (REP 117)
         clear_no_return_m=clear_no_return_m,
-        loop_closure=LoopParams() if loop_closure and scan_matching else None,
+        loop_closure=loops if scan_matching else None,
     )
-    angles = scan0.angle_min + scan0.angle_increment * np.arange(len(scan0.ranges))
-    mapper = ScanMapper(grid, first, params, angles)
+    x0, y0, yaw0 = poses[0]
+    mapper = ScanMapper(grid, (float(x0), float(y0), float(yaw0)), params, angles)
     rows: list[tuple[float, ...]] = []
-    t0 = _stamp_ns(usable[0][0])
-    span_s = max(1e-9, (_stamp_ns(usable[-1][0]) - t0) / 1e9)
+    t0 = int(stamps[0])
+    span_s = max(1e-9, (int(stamps[-1]) - t0) / 1e9)
     start = time.perf_counter()
-    for n, (scan, pose) in enumerate(usable):
-        assert pose is not None
-        t_ns = _stamp_ns(scan)
-        ranges = np.asarray(scan.message.ranges, dtype=np.float32)
-        if len(ranges) != len(angles):
-            raise BagError(
-                f"{bag}: {scan_topic} scan {n} has {len(ranges)} beams; expected "
-                f"{len(angles)} like the first (one lidar per topic)"
-            )
-        mapper.process(t_ns, pose, ranges)
-        estimate = mapper.estimate(pose)
+    for n, (t_ns, beams, pose) in enumerate(zip(stamps, scans, poses, strict=True)):
+        at = (float(pose[0]), float(pose[1]), float(pose[2]))
+        mapper.process(int(t_ns), at, beams)
         node = len(mapper.loops.nodes) - 1 if mapper.loops is not None else -1
-        rows.append((t_ns, *estimate, *pose, node))
+        rows.append((int(t_ns), *mapper.estimate(at), *at, node))
         if progress is not None and n % 20 == 0:
-            progress((t_ns - t0) / 1e9, span_s, time.perf_counter() - start)
+            progress((int(t_ns) - t0) / 1e9, span_s, time.perf_counter() - start)
     if mapper.loops is not None:
         rows = _smoothed(rows, mapper.loops)
     wall_s = time.perf_counter() - start
     if progress is not None:
         progress(span_s, span_s, wall_s)
-    return _result(bag, grid, rows, mapper, reference, wall_s, span_s, len(scans) - len(usable))
+    return MappedScans(grid, rows, mapper, wall_s, span_s)
 
 
 def _smoothed(rows: list[tuple[float, ...]], loops: LoopCloser) -> list[tuple[float, ...]]:
@@ -247,38 +398,31 @@ def _smoothed(rows: list[tuple[float, ...]], loops: LoopCloser) -> list[tuple[fl
     return smoothed
 
 
-def _result(
-    bag: Path,
-    grid: LogOddsMap,
-    rows: Sequence[tuple[float, ...]],
-    mapper: ScanMapper,
-    reference: _Track | None,
-    wall_s: float,
-    span_s: float,
-    skipped: int,
-) -> RecordingMap:
+def _result(recording: Recording, mapped: MappedScans) -> RecordingMap:
+    grid, rows, mapper = mapped.grid, mapped.rows, mapped.mapper
+    wall_s, span_s = mapped.wall_s, mapped.span_s
     table = np.array(rows, dtype=np.float64)
     t_ns = table[:, 0].astype(np.int64)
     trajectory = pd.DataFrame(
         {"t_s": t_ns / 1e9, "x_m": table[:, 1], "y_m": table[:, 2], "yaw_rad": table[:, 3]}
     )
     summary: dict[str, Any] = {
-        "bag": str(bag),
+        "bag": str(recording.bag),
         "scans": len(rows),
-        "scans_outside_odometry": skipped,
+        "scans_outside_odometry": recording.skipped,
         "map_updates": mapper.updates,
         "matched": mapper.matched,
         "loop_closures": mapper.loops.closures if mapper.loops is not None else 0,
+        "loop_closures_not_needed": mapper.loops.not_needed if mapper.loops is not None else 0,
         "recording_s": round(span_s, 3),
         "wall_time_s": round(wall_s, 3),
         "real_time_factor": round(span_s / wall_s, 1) if wall_s > 0 else None,
     }
     drawn = None
-    if reference is not None:
-        at = [reference.at(int(t)) for t in t_ns]
-        keep = np.array([p is not None for p in at])
+    if recording.reference is not None:
+        keep = np.isfinite(recording.reference[:, 0])
         if keep.sum() >= 2:
-            ref_xy = np.array([p[:2] for p in at if p is not None])
+            ref_xy = recording.reference[keep, :2]
             summary["ate_m"] = round(ate_rmse(table[keep, 1:3], ref_xy, align=True), 4)
             summary["ate_odom_m"] = round(ate_rmse(table[keep, 4:6], ref_xy, align=True), 4)
             summary["reference_poses"] = int(keep.sum())

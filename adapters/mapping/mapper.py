@@ -81,7 +81,15 @@ def mapper_params(cfg: MappingConfig, lidar_min_m: float, lidar_max_m: float) ->
         range_min_m=lidar_min_m,
         range_max_m=lidar_max_m,
         clear_no_return_m=cfg.clear_no_return_m,
-        loop_closure=LoopParams() if cfg.loop_closure and cfg.scan_matching != "none" else None,
+        loop_closure=(
+            LoopParams(
+                search_radius_m=cfg.loop_search_radius_m,
+                min_path_m=cfg.loop_min_path_m,
+                min_correction=cfg.loop_min_correction,
+            )
+            if cfg.loop_closure and cfg.scan_matching != "none"
+            else None
+        ),
     )
 
 
@@ -374,5 +382,9 @@ class MappingAdapter:
         for name, grid in zip(self.names, self.maps, strict=True):
             self.recorder.add_map(name, grid.occupancy_grid())
         self.recorder.add_map("fleet", fleet)
-        closures = sum(m.loops.closures for m in self.mappers if m.loops is not None)
-        return {**self.records.summary(), "map_loop_closures": closures}
+        loops = [m.loops for m in self.mappers if m.loops is not None]
+        return {
+            **self.records.summary(),
+            "map_loop_closures": sum(closer.closures for closer in loops),
+            "map_loop_closures_not_needed": sum(closer.not_needed for closer in loops),
+        }

@@ -67,7 +67,21 @@ class MappingConfig:
     loop_closure: bool = param(
         False,
         "each robot closes loops: a pose graph of its map updates, re-solved when a scan "
-        "matches a place mapped long before (Karto / slam_toolbox), its map then rebuilt",
+        "matches a place mapped long before (Karto / slam_toolbox), its map then rebuilt; "
+        "off by default: identical racks can alias (see the mapping guide)",
+    )
+    loop_search_radius_m: float = param(
+        4.0, "loop closure: old map updates within this of the estimate are candidates (m)", gt=0
+    )
+    loop_min_path_m: float = param(
+        10.0, "loop closure: ... only if the robot drove at least this since them (m)", gt=0
+    )
+    loop_min_correction: float = param(
+        7.81,
+        "loop closure: a closure enters the pose graph only if the estimate disagrees with it "
+        "by at least this (squared Mahalanobis distance, its own covariance; 7.81 is the 95 % "
+        "point of chi-square with 3 degrees of freedom; 0 adds every verified closure)",
+        ge=0,
     )
 
     def problems(self) -> Iterator[Problem]:

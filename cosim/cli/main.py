@@ -296,7 +296,8 @@ def _cmd_map(args: argparse.Namespace) -> int:
     s = result.summary
     line = (
         f"{s['scans']} scans, {s['map_updates']} map updates ({s['matched']} matched, "
-        f"{s['loop_closures']} loop closures), "
+        f"{s['loop_closures']} loop closures, {s['loop_closures_not_needed']} revisits "
+        "already in place), "
         f"{s['recording_s']:g} s of recording in {s['wall_time_s']:g} s "
         f"({s['real_time_factor']:g}x real time)"
     )

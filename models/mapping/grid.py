@@ -221,6 +221,24 @@ class LogOddsMap:
         )
         return self._apply(cells, hits, n)
 
+    def fit(self, pose: tuple[float, float, float], points: FloatArray) -> float:
+        """How well ``points`` (sensor frame, m) at ``pose`` lie on the map: mean fine score, 0-1.
+
+        Points off the map score 0.
+        """
+        if len(points) == 0:
+            return 0.0
+        g = self.geometry
+        c, s = math.cos(pose[2]), math.sin(pose[2])
+        wx = pose[0] + c * points[:, 0] - s * points[:, 1]
+        wy = pose[1] + s * points[:, 0] + c * points[:, 1]
+        cx = np.floor((wx - g.origin_xy_m[0]) / g.resolution_m).astype(np.int64)
+        cy = np.floor((wy - g.origin_xy_m[1]) / g.resolution_m).astype(np.int64)
+        height, width = self.score.shape
+        inside = (cx >= 0) & (cy >= 0) & (cx < width) & (cy < height)
+        total = self.score[cy[inside], cx[inside]].astype(np.float64).sum()
+        return float(total / (255.0 * len(points)))
+
     def _apply(self, cells: npt.NDArray[np.int64], hits: npt.NDArray[np.bool_], n: int) -> int:
         p = self.params
         flips = np.empty(min(n, 4096) + 64, dtype=np.int64)

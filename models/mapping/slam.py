@@ -25,6 +25,7 @@ from models.mapping.grid import LogOddsMap
 from models.mapping.loops import LoopCloser, LoopParams
 from models.mapping.matcher import MatcherParams, match, scan_points
 from models.mapping.se2 import Pose, compose, inverse, relative
+from models.mapping.uncertainty import match_covariance
 
 
 @dataclass(frozen=True)
@@ -166,6 +167,7 @@ class ScanMapper:
             return None
         prior = compose(self._estimate_ref, motion)
         pose, score, matched = prior, 0.0, False
+        covariance = None
         if p.scan_matching and not self.grid.empty:
             points = scan_points(
                 self.angles,
@@ -176,7 +178,11 @@ class ScanMapper:
             )
             result = match(self.grid, prior, points, p.matcher)
             pose, score, matched = result.pose, result.score, result.matched
-        return self._add(t_ns, odom, pose, prior, score, matched, ranges_m)
+            if matched and p.loop_closure is not None:
+                # how sure the match is: the pose graph's trust in this step
+                window = p.loop_closure.sequential_response
+                covariance = match_covariance(self.grid, pose, points, window)
+        return self._add(t_ns, odom, pose, prior, score, matched, ranges_m, covariance)
 
     def _add(
         self,
@@ -187,6 +193,7 @@ class ScanMapper:
         score: float,
         matched: bool,
         ranges_m: npt.NDArray[np.floating[Any]],
+        covariance: FloatArray | None = None,
     ) -> Update:
         p = self.params
         flipped = self.grid.integrate(
@@ -198,7 +205,8 @@ class ScanMapper:
             clear_no_return_m=p.clear_no_return_m,
         )
         if self.loops is not None:
-            self.loops.add(pose, odom, np.asarray(ranges_m, dtype=np.float32), matched)
+            ranges = np.asarray(ranges_m, dtype=np.float32)
+            self.loops.add(pose, odom, ranges, matched, covariance)
             closed = self.loops.close(self.grid)
             if closed is not None:
                 pose = closed

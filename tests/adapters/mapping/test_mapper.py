@@ -101,9 +101,13 @@ def test_the_same_seed_gives_the_same_maps_and_tables(tmp_path):
 
 
 @pytest.mark.slow
-def test_robots_can_close_loops_in_a_run(tmp_path):
-    closed = _run(tmp_path, **{"mapping.loop_closure": True, "scenario.duration_s": 60.0})
-    assert closed.summary["map_loop_closures"] > 0
+def test_robots_recognise_their_loops_in_a_run_as_far_as_their_settings_search(tmp_path):
+    loops = {"mapping.loop_closure": True, "scenario.duration_s": 60.0}
+    closed = _run(tmp_path / "a", **loops)
+    revisits = closed.summary["map_loop_closures"] + closed.summary["map_loop_closures_not_needed"]
+    assert revisits > 0
+    blind = _run(tmp_path / "b", **loops, **{"mapping.loop_search_radius_m": 0.01})
+    assert blind.summary["map_loop_closures"] + blind.summary["map_loop_closures_not_needed"] == 0
     assert closed.summary["map_ate_m"] <= closed.summary["map_ate_odom_m"] / 3
 
 

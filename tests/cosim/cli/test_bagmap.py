@@ -60,16 +60,16 @@ def test_mapping_a_bag_of_ours_corrects_its_drifting_odometry(drifting_bag, tmp_
 
 
 @pytest.mark.slow
-def test_the_aces_building_maps_with_a_third_of_the_odometrys_error(tmp_path):
+def test_the_aces_building_maps_within_five_percent_of_the_odometrys_error(tmp_path):
     if not ACES.is_dir():
         pytest.skip(f"{ACES} (the shared sample data) is not beside this clone")
     done = _cli("map", str(ACES), "--out", str(tmp_path), "--reference", "/ground_truth", "--quiet")
     assert done.returncode == 0, done.stderr
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["ate_odom_m"] == pytest.approx(3.32, abs=0.01)  # as the data's README says
-    assert summary["ate_m"] <= summary["ate_odom_m"] / 3
-    assert summary["loop_closures"] > 0
-    assert "trajectory error" in done.stdout
+    assert summary["ate_m"] <= 0.05 * summary["ate_odom_m"]
+    assert summary["loop_closures"] + summary["loop_closures_not_needed"] > 0
+    assert "trajectory error" in done.stdout and "revisits already in place" in done.stdout
 
 
 @pytest.mark.parametrize(

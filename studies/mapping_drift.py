@@ -1,0 +1,187 @@
+"""Mapping real buildings on drift realizations: does the result depend on the one recorded?
+
+Each shared building recording (``../shared/data``) carries one drifting odometry. This
+study draws other realizations of the same drift model
+(:func:`models.mapping.drift.drifting_odometry`, seeds 1..N), maps every one with
+scan-to-map matching alone and with loop closure (``cosim map``'s defaults), and compares
+the trajectory errors (ATE: RMS after rigid SE(2) alignment against ``/ground_truth``).
+The shared realizations themselves come first.
+
+    .venv/bin/python studies/mapping_drift.py --seeds 30 --workers 2
+
+Writes studies/results/mapping_drift/{results.csv, report.md, ate_by_seed.png}.
+Acceptance (issue 33): loop closure never more than 1 cm worse than scan-to-map alone;
+within 5 % of the odometry's error on every building and realization (3 % the moonshot);
+>= 100x the recording's real time.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+from typing import Any
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
+from matplotlib.ticker import FormatStrFormatter
+
+from adapters.mapping.bagmap import Recording, map_scans, read_recording
+from models.mapping.drift import drifting_odometry
+from models.mapping.quality import ate_rmse
+
+SHARED = Path(__file__).resolve().parents[2] / "shared" / "data"
+BUILDINGS = {"aces_lidar": "ACES (Austin)", "fr079_lidar": "Freiburg 079"}
+SHARED_REALIZATIONS = {  # recording: (building, the drift seed it was made with)
+    "aces_lidar": ("aces_lidar", 7),
+    "aces_lidar_s12": ("aces_lidar", 12),
+    "aces_lidar_s13": ("aces_lidar", 13),
+    "fr079_lidar": ("fr079_lidar", 11),
+}
+_recordings: dict[str, Recording] = {}
+
+
+def _recording(name: str) -> Recording:
+    if name not in _recordings:
+        _recordings[name] = read_recording(SHARED / name, reference_topic="/ground_truth")
+    return _recordings[name]
+
+
+def one(job: tuple[str, str, int, bool]) -> dict[str, Any]:
+    """One realization of one building, mapped both ways."""
+    building, source, seed, shared = job
+    recording = _recording(source)
+    reference = recording.reference
+    assert reference is not None
+    odometry = recording.odometry if shared else drifting_odometry(reference, seed)
+    row: dict[str, Any] = {
+        "building": building,
+        "seed": seed,
+        "shared": shared,
+        "odometry_ate_m": ate_rmse(odometry[:, :2], reference[:, :2], align=True),
+    }
+    for loops, key in ((False, "scan_to_map"), (True, "loop_closure")):
+        mapped = map_scans(
+            recording.stamps_ns, recording.ranges_m, odometry, recording.angles_rad,
+            range_min_m=recording.range_min_m, range_max_m=recording.range_max_m,
+            loop_closure=loops,
+        )  # fmt: skip
+        row[f"{key}_ate_m"] = ate_rmse(mapped.estimate_xy_m(), reference[:, :2], align=True)
+        row[f"{key}_rtf"] = mapped.span_s / mapped.wall_s
+        if loops and mapped.mapper.loops is not None:
+            row["closures"] = mapped.mapper.loops.closures
+            row["closures_not_needed"] = mapped.mapper.loops.not_needed
+    return row
+
+
+def _figure(frame: pd.DataFrame, path: Path) -> None:
+    fig, axes = plt.subplots(1, len(BUILDINGS), figsize=(12, 4.2), sharey=True)
+    for ax, (building, title) in zip(np.atleast_1d(axes), BUILDINGS.items(), strict=True):
+        rows = frame[frame.building == building].reset_index(drop=True)
+        x = np.arange(len(rows))
+        for key, label, style in (
+            ("loop_closure", "with loop closure (default)",
+             {"marker": "s", "s": 16, "color": "tab:orange"}),
+            ("scan_to_map", "scan-to-map only (hollow: shows where the two coincide)",
+             {"marker": "o", "s": 46, "facecolors": "none", "edgecolors": "tab:blue"}),
+        ):  # fmt: skip
+            share = 100 * rows[f"{key}_ate_m"] / rows.odometry_ate_m
+            ax.scatter(x, share, label=label, **style)
+        ax.axhline(5.0, color="k", lw=0.8, ls="--", label="goal: 5 % of odometry")
+        ax.set_yscale("log")
+        ax.yaxis.set_major_formatter(FormatStrFormatter("%g"))
+        ax.yaxis.set_minor_formatter(FormatStrFormatter("%g"))
+        ax.tick_params(axis="y", which="both", labelsize=7)
+        ax.set_xticks(
+            x, [f"{s}{'*' if sh else ''}" for s, sh in zip(rows.seed, rows.shared, strict=True)]
+        )
+        ax.tick_params(axis="x", labelsize=6, rotation=90)
+        ax.set_title(f"{title}: {len(rows)} drift realizations")
+        ax.set_xlabel("drift seed (* the shared recordings')")
+    np.atleast_1d(axes)[0].set_ylabel("trajectory error, % of odometry's")
+    np.atleast_1d(axes)[0].legend(fontsize=7, loc="upper right")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def _report(frame: pd.DataFrame, seeds: int, wall_s: float, workers: int) -> str:
+    frame = frame.assign(
+        diff_cm=100 * (frame.loop_closure_ate_m - frame.scan_to_map_ate_m),
+        loop_pct=100 * frame.loop_closure_ate_m / frame.odometry_ate_m,
+        s2m_pct=100 * frame.scan_to_map_ate_m / frame.odometry_ate_m,
+    )
+    summary = frame.groupby("building").agg(
+        realizations=("seed", "count"),
+        odometry_ate_m=("odometry_ate_m", lambda v: f"{v.min():.2f}-{v.max():.2f}"),
+        scan_to_map_ate_m=("scan_to_map_ate_m", lambda v: f"{v.min():.3f}-{v.max():.3f}"),
+        loop_closure_ate_m=("loop_closure_ate_m", lambda v: f"{v.min():.3f}-{v.max():.3f}"),
+        loop_pct_median=("loop_pct", "median"),
+        loop_pct_max=("loop_pct", "max"),
+        over_5pct=("loop_pct", lambda v: int((v > 5).sum())),
+        worse_by_over_1cm=("diff_cm", lambda v: int((v > 1).sum())),
+        largest_diff_cm=("diff_cm", "max"),
+        loop_rtf_min=("loop_closure_rtf", "min"),
+    )
+    shown = frame[
+        ["building", "seed", "shared", "odometry_ate_m", "scan_to_map_ate_m",
+         "loop_closure_ate_m", "loop_pct", "diff_cm", "closures", "closures_not_needed"]
+    ]  # fmt: skip
+    return (
+        "# Mapping on drift realizations\n\n"
+        f"Each building's recording with its shared drift realization(s) and {seeds} more "
+        "(drift seeds 1..N of the shared data's model); scan-to-map matching alone and with "
+        f"loop closure (`cosim map`'s defaults). {wall_s:.0f} s wall on {workers} workers.\n\n"
+        "![trajectory error by drift seed](ate_by_seed.png)\n\n"
+        "## Per building\n\n"
+        + summary.round(2).to_markdown()
+        + "\n\n## Per realization\n\n"
+        + shown.round(4).to_markdown(index=False)
+        + "\n"
+    )
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seeds", type=int, default=30, help="drift seeds 1..N per building")
+    parser.add_argument("--workers", type=int, default=2, help="processes")
+    parser.add_argument(
+        "--out", type=Path, default=Path(__file__).parent / "results" / "mapping_drift"
+    )
+    args = parser.parse_args(argv)
+    missing = [n for n in SHARED_REALIZATIONS if not (SHARED / n).is_dir()]
+    if missing:
+        print(f"mapping_drift: {SHARED}/{missing[0]} is not beside this clone", file=sys.stderr)
+        return 2
+    jobs = [(b, name, seed, True) for name, (b, seed) in SHARED_REALIZATIONS.items()]
+    jobs += [(b, b, s, False) for b in BUILDINGS for s in range(1, args.seeds + 1)]
+    start = time.perf_counter()
+    rows = []
+    with ProcessPoolExecutor(args.workers) as pool:
+        for k, row in enumerate(pool.map(one, jobs), 1):
+            rows.append(row)
+            print(
+                f"[{k}/{len(jobs)}] {row['building']} seed {row['seed']}: odometry "
+                f"{row['odometry_ate_m']:.2f} m, scan-to-map {row['scan_to_map_ate_m']:.3f} m, "
+                f"loop closure {row['loop_closure_ate_m']:.3f} m",
+                file=sys.stderr,
+                flush=True,
+            )
+    frame = pd.DataFrame(rows)
+    args.out.mkdir(parents=True, exist_ok=True)
+    frame.to_csv(args.out / "results.csv", index=False)
+    _figure(frame, args.out / "ate_by_seed.png")
+    text = _report(frame, args.seeds, time.perf_counter() - start, args.workers)
+    (args.out / "report.md").write_text(text)
+    print(f"report: {args.out / 'report.md'}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
