@@ -114,7 +114,8 @@ def recordings_mapping(repeat: int) -> Result:
     Target (issue 33): >= 100x the recording's real time with loop closure, and loop
     closure never more than 1 cm worse than scan-to-map alone.
     """
-    from adapters.mapping.bagmap import map_scans, read_recording
+    from adapters.mapping.bagmap import map_scans
+    from adapters.mapping.recording import read_recording
     from models.mapping.quality import ate_rmse
 
     out: Result = {"target_real_time_factor": 100.0}

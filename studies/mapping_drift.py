@@ -32,7 +32,8 @@ import numpy as np
 import pandas as pd
 from matplotlib.ticker import FormatStrFormatter
 
-from adapters.mapping.bagmap import Recording, map_scans, read_recording
+from adapters.mapping.bagmap import map_scans
+from adapters.mapping.recording import Recording, read_recording
 from models.mapping.drift import drifting_odometry
 from models.mapping.quality import ate_rmse
 

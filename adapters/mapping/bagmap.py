@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -20,26 +20,23 @@ import numpy as np
 import numpy.typing as npt
 import pandas as pd
 
-from adapters.mocap.tracks import planar_pose
-from cosim.core.bags import BagMessage, bag_info, read_messages
+from adapters.mapping.recording import (
+    Recording,
+    read_recording,
+)
 from cosim.core.errors import BagError
-from models.mapping.grid import LogOddsMap, MapGeometry
+from models.mapping.grid import MAX_CELLS, LogOddsMap, MapGeometry
 from models.mapping.loops import LoopCloser, LoopParams
 from models.mapping.matcher import MatcherParams
 from models.mapping.quality import align_se2, ate_rmse
 from models.mapping.se2 import compose, relative
 from models.mapping.slam import MapperParams, ScanMapper, UpdateGate
 
-SCAN_TYPES = ("sensor_msgs/msg/LaserScan",)
-ODOM_TYPES = ("nav_msgs/msg/Odometry",)
-REFERENCE_TYPES = (
-    "nav_msgs/msg/Odometry",
-    "geometry_msgs/msg/PoseStamped",
-    "geometry_msgs/msg/PoseWithCovarianceStamped",
-)
 MAP_REACH_M = 30.0
 """The map reaches this far beyond the odometry's extent (m); returns beyond fall off."""
-
+RESOLUTION_M = (0.01, 1.0)
+"""The cell sizes ``cosim map`` takes (m): finer than a 2D lidar's centimetre noise maps
+nothing more, and a cell coarser than the matcher's 0.3 m window leaves nothing to match."""
 Progress = Callable[[float, float, float], None]
 """(recording time processed s, recording duration s, wall s)."""
 
@@ -65,174 +62,6 @@ class RecordingMap:
     reference_xy_m: npt.NDArray[np.float64] | None = field(default=None, repr=False)
 
 
-@dataclass(frozen=True)
-class _Track:
-    """Timed planar poses, to interpolate."""
-
-    t_ns: npt.NDArray[np.int64]
-    xyyaw: npt.NDArray[np.float64]
-
-    def at(self, t_ns: int) -> tuple[float, float, float] | None:
-        """The pose at ``t_ns`` (linear, yaw unwrapped), None outside the track."""
-        t = self.t_ns
-        if len(t) == 0 or t_ns < t[0] or t_ns > t[-1]:
-            return None
-        k = int(np.searchsorted(t, t_ns))
-        if t[k] == t_ns or k == 0:
-            x, y, yaw = self.xyyaw[k]
-            return float(x), float(y), float(yaw)
-        a = (t_ns - t[k - 1]) / (t[k] - t[k - 1])
-        p, q = self.xyyaw[k - 1], self.xyyaw[k]
-        dyaw = math.remainder(q[2] - p[2], 2 * math.pi)
-        return (
-            float(p[0] + a * (q[0] - p[0])),
-            float(p[1] + a * (q[1] - p[1])),
-            float(math.remainder(p[2] + a * dyaw, 2 * math.pi)),
-        )
-
-
-def _stamp_ns(message: BagMessage) -> int:
-    header = getattr(message.message, "header", None)
-    if header is not None:
-        stamp = int(header.stamp.sec) * 1_000_000_000 + int(header.stamp.nanosec)
-        if stamp > 0:
-            return stamp
-    return message.t_ns
-
-
-def _pose(message: BagMessage) -> tuple[float, float, float]:
-    return planar_pose(message.message, message.msgtype)
-
-
-def _check_types(bag: Path, wanted: Sequence[tuple[str, str, Sequence[str]]]) -> None:
-    """Every (option, topic, accepted types) present and typed right, else one BagError line."""
-    topics = {t.name: t for t in bag_info(bag).topics}
-    for option, topic, accepted in wanted:
-        found = topics.get(topic)
-        if found is None:
-            listing = ", ".join(f"{t.name} ({t.msgtype})" for t in topics.values()) or "none"
-            raise BagError(
-                f"{bag}: {option} {topic}: no such topic; expected one of {', '.join(accepted)} "
-                f"(the bag has {listing})"
-            )
-        if found.msgtype not in accepted:
-            raise BagError(
-                f"{bag}: {option} {topic} is {found.msgtype}; expected {', '.join(accepted)}"
-            )
-        if found.count == 0:
-            raise BagError(f"{bag}: {option} {topic} has no messages")
-
-
-def _track(messages: list[BagMessage]) -> _Track:
-    rows = sorted((_stamp_ns(m), *_pose(m)) for m in messages)
-    t = np.array([r[0] for r in rows], dtype=np.int64)
-    xyyaw = np.array([r[1:] for r in rows], dtype=np.float64).reshape(-1, 3)
-    return _Track(t, xyyaw)
-
-
-def check_topics(
-    bag: Path, scan_topic: str, odom_topic: str, reference_topic: str | None
-) -> list[str]:
-    """The topics to read, checked present and of the right types.
-
-    Raises:
-        BagError: not a bag, or a topic missing, empty or of the wrong type (one line).
-    """
-    wanted: list[tuple[str, str, Sequence[str]]] = [
-        ("--scan", scan_topic, SCAN_TYPES),
-        ("--odom", odom_topic, ODOM_TYPES),
-    ]
-    if reference_topic is not None:
-        wanted.append(("--reference", reference_topic, REFERENCE_TYPES))
-    _check_types(bag, wanted)
-    return sorted({topic for _, topic, _ in wanted})
-
-
-@dataclass(frozen=True)
-class Recording:
-    """A recording's scans with the odometry (and reference) at each one's stamp.
-
-    Attributes:
-        bag: where it was read from.
-        stamps_ns: (scans,) each scan's stamp (ns), increasing.
-        ranges_m: (scans, beams) the ranges (m).
-        angles_rad: (beams,) the beams' angles in the sensor frame (rad).
-        range_min_m: shorter readings are invalid (m).
-        range_max_m: the lidar's maximum range (m).
-        odometry: (scans, 3) x m, y m, yaw rad (frame ``odom``), interpolated.
-        reference: (scans, 3) the reference pose at each scan, NaN outside it; None
-            without a reference topic.
-        skipped: scans outside the odometry's time span, left out.
-    """
-
-    bag: Path
-    stamps_ns: npt.NDArray[np.int64] = field(repr=False)
-    ranges_m: npt.NDArray[np.float32] = field(repr=False)
-    angles_rad: npt.NDArray[np.float64] = field(repr=False)
-    range_min_m: float
-    range_max_m: float
-    odometry: npt.NDArray[np.float64] = field(repr=False)
-    reference: npt.NDArray[np.float64] | None = field(repr=False)
-    skipped: int
-
-
-def read_recording(
-    bag: Path,
-    *,
-    scan_topic: str = "/scan",
-    odom_topic: str = "/odom",
-    reference_topic: str | None = None,
-) -> Recording:
-    """A bag's scans, each with the odometry (and reference) interpolated at its stamp.
-
-    Raises:
-        BagError: not a bag, a topic missing or of the wrong type, scans of different
-            sizes, no scan that odometry covers.
-    """
-    bag = Path(bag)
-    topics = check_topics(bag, scan_topic, odom_topic, reference_topic)
-    messages = list(read_messages(bag, topics))
-    scans = [m for m in messages if m.topic == scan_topic]
-    odom = _track([m for m in messages if m.topic == odom_topic])
-    reference = (
-        _track([m for m in messages if m.topic == reference_topic]) if reference_topic else None
-    )
-    paired = [(s, odom.at(_stamp_ns(s))) for s in scans]
-    usable = [(s, o) for s, o in paired if o is not None]
-    if not usable:
-        raise BagError(
-            f"{bag}: no scan on {scan_topic} falls within the odometry on {odom_topic} "
-            "(their stamps do not overlap)"
-        )
-    scan0 = usable[0][0].message
-    angles = scan0.angle_min + scan0.angle_increment * np.arange(len(scan0.ranges))
-    ranges = np.zeros((len(usable), len(angles)), dtype=np.float32)
-    for n, (scan, _) in enumerate(usable):
-        beams = np.asarray(scan.message.ranges, dtype=np.float32)
-        if len(beams) != len(angles):
-            raise BagError(
-                f"{bag}: {scan_topic} scan {n} has {len(beams)} beams; expected "
-                f"{len(angles)} like the first (one lidar per topic)"
-            )
-        ranges[n] = beams
-    stamps = np.array([_stamp_ns(s) for s, _ in usable], dtype=np.int64)
-    at_reference = None
-    if reference is not None:
-        nowhere = (math.nan, math.nan, math.nan)
-        at_reference = np.array([reference.at(int(t)) or nowhere for t in stamps])
-    return Recording(
-        bag,
-        stamps,
-        ranges,
-        np.asarray(angles, dtype=np.float64),
-        float(scan0.range_min),
-        float(scan0.range_max),
-        np.array([o for _, o in usable], dtype=np.float64),
-        at_reference,
-        len(scans) - len(usable),
-    )
-
-
 def map_recording(
     bag: Path,
     *,
@@ -250,12 +79,20 @@ def map_recording(
     """Map a recorded bag: :func:`read_recording`, then :func:`map_scans`.
 
     Raises:
-        BagError: not a bag, a topic missing or of the wrong type, no scan that odometry
-            covers.
+        BagError: as :func:`read_recording`, or odometry spanning more than a map of
+            :data:`~models.mapping.grid.MAX_CELLS` cells at ``resolution_m`` (one line
+            naming the topic, the extent and the cell size that would fit).
+        ValueError: ``resolution_m`` outside :data:`RESOLUTION_M`.
     """
+    low, high = RESOLUTION_M
+    if not low <= resolution_m <= high:
+        raise ValueError(f"resolution_m {resolution_m!r}: expected {low:g} to {high:g} m")
     recording = read_recording(
         bag, scan_topic=scan_topic, odom_topic=odom_topic, reference_topic=reference_topic
     )
+    reach = min(recording.range_max_m, MAP_REACH_M)
+    if too_large := _oversize(recording.odometry, reach, resolution_m, "--resolution-m"):
+        raise BagError(f"{recording.bag}: --odom {odom_topic} {too_large}")
     mapped = map_scans(
         recording.stamps_ns,
         recording.ranges_m,
@@ -344,18 +181,25 @@ def map_scans(
             f"and {len(angles)} angles; expected as many stamps, scans and poses (at least "
             "one) and a range per angle"
         )
-    xy = poses[:, :2]
-    lo, hi = xy.min(axis=0), xy.max(axis=0)
+    _check_arguments(poses, angles, range_min_m, range_max_m, resolution_m, clear_no_return_m)
     reach = min(range_max_m, MAP_REACH_M)
+    if too_large := _oversize(poses, reach, resolution_m, "resolution_m"):
+        raise ValueError(f"the odometry {too_large}")
+    lo, hi = poses[:, :2].min(axis=0), poses[:, :2].max(axis=0)
     geometry = MapGeometry.covering((lo[0], lo[1], hi[0], hi[1]), resolution_m, reach)
     grid = LogOddsMap(geometry)
+    # readings at the maximum are no return (REP 117, and CARMEN logs' clip value)
+    limit_m = range_max_m * 0.999
+    far_m = 2.0 * math.hypot(geometry.width, geometry.height) * resolution_m
+    if limit_m > far_m:  # never with a real lidar: far_m >= 170 m once range_max >= 30 m
+        scans, limit_m = _returns_within(scans, limit_m, far_m), far_m
     loops = LoopParams() if loop_closure is True else (loop_closure or None)
     params = MapperParams(
         gate=gate or UpdateGate(),
         matcher=matcher or MatcherParams(),
         scan_matching=scan_matching,
         range_min_m=range_min_m,
-        range_max_m=range_max_m * 0.999,  # readings at the maximum are no return (REP 117)
+        range_max_m=limit_m,
         clear_no_return_m=clear_no_return_m,
         loop_closure=loops if scan_matching else None,
     )
@@ -378,6 +222,82 @@ def map_scans(
     if progress is not None:
         progress(span_s, span_s, wall_s)
     return MappedScans(grid, rows, mapper, wall_s, span_s)
+
+
+def _check_arguments(
+    poses: npt.NDArray[np.float64],
+    angles: npt.NDArray[np.float64],
+    range_min_m: float,
+    range_max_m: float,
+    resolution_m: float,
+    clear_no_return_m: float,
+) -> None:
+    """:func:`map_scans`' arguments usable, else a ValueError naming the first that is not."""
+    if not np.isfinite(poses).all():
+        raise ValueError(f"odometry pose {np.argwhere(~np.isfinite(poses))[0][0]} is not finite")
+    if not np.isfinite(angles).all():
+        raise ValueError("angles_rad: expected finite angles (rad)")
+    if not (math.isfinite(range_min_m) and range_min_m >= 0 and range_max_m > range_min_m):
+        raise ValueError(
+            f"range_min_m {range_min_m!r}, range_max_m {range_max_m!r}: expected 0 <= "
+            "range_min_m < range_max_m"
+        )
+    if not (math.isfinite(resolution_m) and resolution_m > 0):
+        raise ValueError(f"resolution_m {resolution_m!r}: expected a cell size > 0 (m)")
+    if not (math.isfinite(clear_no_return_m) and clear_no_return_m >= 0):
+        raise ValueError(f"clear_no_return_m {clear_no_return_m!r}: expected a length >= 0 (m)")
+
+
+def _oversize(
+    poses: npt.NDArray[np.float64], reach_m: float, resolution_m: float, flag: str
+) -> str | None:
+    """Why the map around ``poses`` (m) would be too large at ``resolution_m``, or None.
+
+    The map covers the poses and ``reach_m`` all round (as :func:`map_scans` builds it);
+    it may hold :data:`~models.mapping.grid.MAX_CELLS` cells (100 MB of log-odds).
+    """
+    lo, hi = poses[:, :2].min(axis=0), poses[:, :2].max(axis=0)
+    span = (float(hi[0] - lo[0]) + 2 * reach_m, float(hi[1] - lo[1]) + 2 * reach_m)
+
+    def cells(resolution: float) -> tuple[int, int]:
+        return math.ceil(span[0] / resolution), math.ceil(span[1] / resolution)
+
+    width, height = cells(resolution_m)
+    if width * height <= MAX_CELLS:
+        return None
+    steps = np.hypot(*np.diff(poses[:, :2], axis=0).T) if len(poses) > 1 else np.zeros(1)
+    jump = int(np.argmax(steps))
+    fits = max(resolution_m, math.sqrt(span[0] * span[1] / MAX_CELLS))
+    while math.prod(cells(fits)) > MAX_CELLS:
+        fits *= 1.001
+    coarser = (
+        f"{flag} {math.ceil(fits * 1000) / 1000:g} or more fits"
+        if fits <= RESOLUTION_M[1]
+        else f"no {flag} up to {RESOLUTION_M[1]:g} m fits: is the odometry wrong?"
+    )
+    return (
+        f"spans {hi[0] - lo[0]:.1f} m x {hi[1] - lo[1]:.1f} m at the scans (x {lo[0]:.1f} to "
+        f"{hi[0]:.1f} m, y {lo[1]:.1f} to {hi[1]:.1f} m; its largest step, {steps[jump]:.1f} m, "
+        f"between scans {jump} and {jump + 1}): with the lidar's reach ({reach_m:g} m) all round, "
+        f"a map at {flag} {resolution_m:g} would be {width:,} x {height:,} cells; expected at "
+        f"most {MAX_CELLS:,} cells ({MAX_CELLS * 4 / 1e6:,.0f} MB): {coarser}"
+    )
+
+
+def _returns_within(
+    scans: npt.NDArray[np.float32], limit_m: float, far_m: float
+) -> npt.NDArray[np.float32]:
+    """Returns farther than ``far_m`` (m) moved to just within it; everything else as is.
+
+    ``far_m`` is twice the map's diagonal: such a return ends outside the map and its beam
+    stops at the map's edge either way, so no cell changes; the work per beam stays
+    bounded. It is what lets a lidar without a maximum (range_max inf, as
+    pointcloud_to_laserscan publishes) keep +inf as no return (REP 117).
+    """
+    cap = np.nextafter(np.float32(far_m), np.float32(0))
+    wide = scans.astype(np.float64)
+    returns = np.isfinite(wide) & (wide > cap) & (wide <= limit_m)
+    return np.where(returns, cap, scans).astype(np.float32)
 
 
 def _smoothed(rows: list[tuple[float, ...]], loops: LoopCloser) -> list[tuple[float, ...]]:

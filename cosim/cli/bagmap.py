@@ -15,7 +15,8 @@ from typing import Any
 
 import pandas as pd
 
-from adapters.mapping.bagmap import Progress, check_topics, map_recording
+from adapters.mapping.bagmap import Progress, map_recording
+from adapters.mapping.recording import check_topics
 from adapters.world.files import write_map
 from cosim.core.errors import ExportError
 from models.mapping.matcher import MatcherParams
@@ -61,13 +62,17 @@ def map_bag(
     """Map a recorded bag and write the results into ``out``.
 
     Raises:
-        BagError: not a bag, a topic missing or of the wrong type, no scan that odometry
-            covers.
+        BagError: one line naming the bag, topic, message and value, as
+            :func:`~adapters.mapping.bagmap.map_recording`: not a bag, a topic missing or
+            of the wrong type, unusable scans or poses, stamps not increasing, no scan that
+            odometry covers, odometry spanning more than a map can hold.
         ExportError: ``out`` is not empty (without ``force``) or cannot be written.
+        ValueError: ``resolution_m`` outside
+            :data:`~adapters.mapping.bagmap.RESOLUTION_M` (the CLI refuses it as parsed).
     """
     bag, out = Path(bag), Path(out)
-    check_topics(bag, scan_topic, odom_topic, reference_topic)  # before touching ``out``
-    _prepare(out, force)
+    check_topics(bag, scan_topic, odom_topic, reference_topic)
+    _check_out(out, force)  # before the work; results replaced only once it succeeded
     mapped = map_recording(
         bag,
         scan_topic=scan_topic,
@@ -81,6 +86,7 @@ def map_bag(
         clear_no_return_m=clear_no_return_m,
         progress=progress,
     )
+    _clear(out)
     out.mkdir(parents=True, exist_ok=True)
     try:
         files = write_map(mapped.grid.occupancy_grid(), out / "map.yaml")
@@ -108,10 +114,16 @@ def map_bag(
     return BagMapResult(out, mapped.summary, mapped.trajectory, files)
 
 
-def _prepare(out: Path, force: bool) -> None:
+def _check_out(out: Path, force: bool) -> None:
     if out.exists() and not out.is_dir():
         raise ExportError(f"{out}: exists and is not a folder")
     if out.is_dir() and any(out.iterdir()) and not force:
         raise ExportError(f"{out}: folder is not empty; not overwriting (use --force)")
-    for name in OUTPUTS:
-        (out / name).unlink(missing_ok=True)
+
+
+def _clear(out: Path) -> None:
+    try:
+        for name in OUTPUTS:
+            (out / name).unlink(missing_ok=True)
+    except OSError as error:
+        raise ExportError(f"{out}: cannot replace earlier results ({error})") from None

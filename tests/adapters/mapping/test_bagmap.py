@@ -9,7 +9,8 @@ written here: checked to draw the shared realizations again, then drawn with oth
 import numpy as np
 import pytest
 
-from adapters.mapping.bagmap import Recording, map_scans, read_recording
+from adapters.mapping.bagmap import map_scans
+from adapters.mapping.recording import Recording, read_recording
 from models.mapping.drift import drifting_odometry
 from models.mapping.quality import ate_rmse
 from tests.conftest import SHARED_DATA
