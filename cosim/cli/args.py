@@ -71,6 +71,25 @@ def _positive_float(text: str) -> float:
     return value
 
 
+def _between(text: str, low: float, high: float, what: str, unit: str = "") -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not low <= value <= high:  # NaN too
+        raise argparse.ArgumentTypeError(f"{text} is not {what} from {low:g} to {high:g}{unit}")
+    return value
+
+
+def _cell_size_m(text: str) -> float:
+    # the bounds of adapters.mapping.bagmap.RESOLUTION_M (not imported: numpy at start-up)
+    return _between(text, 0.01, 1.0, "a map cell size", " m")
+
+
+def _score(text: str) -> float:
+    return _between(text, 0.0, 1.0, "a score")
+
+
 def _port(text: str) -> int:
     value = _non_negative_int(text)
     if value > 65535:
@@ -230,6 +249,13 @@ def build_parser() -> argparse.ArgumentParser:
         help="run on this Dask scheduler instead of local processes",
     )
     study.add_argument(
+        "--scheduler-timeout-s",
+        type=_positive_float,
+        default=20.0,
+        metavar="S",
+        help="how long to wait for the Dask scheduler to answer (default: 20 s)",
+    )
+    study.add_argument(
         "--resume",
         action="store_true",
         help="continue a study in --out: skip finished runs, retry failed ones",
@@ -275,7 +301,10 @@ def build_parser() -> argparse.ArgumentParser:
         "measure the trajectory error against",
     )
     mapping.add_argument(
-        "--resolution-m", type=_positive_float, default=0.05, help="map cell size (0.05 m)"
+        "--resolution-m",
+        type=_cell_size_m,
+        default=0.05,
+        help="map cell size, 0.01 to 1 m (0.05 m)",
     )
     mapping.add_argument(
         "--min-travel-m",
@@ -291,7 +320,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     mapping.add_argument(
         "--match-margin",
-        type=_non_negative_float,
+        type=_score,
         default=0.0,
         help="score (0..1) by which a matched pose must beat the odometry's prediction "
         "(default 0: corrections of noisy real odometry matter; runs use 0.02)",

@@ -235,25 +235,38 @@ def _cmd_world(args: argparse.Namespace) -> int:
 
 
 def _cmd_study(args: argparse.Namespace) -> int:
+    from cosim.studies.lifeline import StudyStopped, stop_on_signals
     from cosim.studies.runner import Progress, run_study
     from cosim.studies.spec import load_study
 
-    spec = load_study(args.study)
-    out = args.out or Path("runs") / "studies" / spec.name
-    total = len(spec.runs())
-    where = f"Dask at {args.scheduler}" if args.scheduler else f"{args.workers or 'all'} workers"
-    print(
-        f"{spec.name}: {total} runs ({len(spec.combinations())} combinations x "
-        f"{len(spec.seeds)} seeds) on {where} -> {out}/"
-    )
-    results = run_study(
-        spec,
-        out,
-        workers=args.workers,
-        scheduler=args.scheduler,
-        resume=args.resume,
-        progress=None if args.quiet else Progress(),
-    )
+    # SIGTERM stops a study as Ctrl-C does: finished runs kept, one line, 128 + the signal
+    try:
+        with stop_on_signals():
+            spec = load_study(args.study)
+            out = args.out or Path("runs") / "studies" / spec.name
+            total = len(spec.runs())
+            where = (
+                f"Dask at {args.scheduler}"
+                if args.scheduler
+                else f"{args.workers or 'all'} workers"
+            )
+            print(
+                f"{spec.name}: {total} runs ({len(spec.combinations())} combinations x "
+                f"{len(spec.seeds)} seeds) on {where} -> {out}/",
+                flush=True,
+            )
+            results = run_study(
+                spec,
+                out,
+                workers=args.workers,
+                scheduler=args.scheduler,
+                scheduler_timeout_s=args.scheduler_timeout_s,
+                resume=args.resume,
+                progress=None if args.quiet else Progress(),
+            )
+    except StudyStopped as stop:
+        print(f"cosim: {stop.message}", file=sys.stderr)
+        return stop.exit_status
     failed = int((results["status"] != "ok").sum()) if len(results) else 0
     print(
         f"results: {out}/results.parquet ({len(results)} runs, {failed} failed)"

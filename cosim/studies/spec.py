@@ -2,9 +2,9 @@
 
 ```toml
 [study]
-name = "comm_sweep"
+name = "comm_sweep"               # a folder name: letters, digits, '_', '-', '.', '+'
 scenario = "warehouse-random"     # a preset, or a path relative to the study file
-seeds = 10                        # a count (seeds 1..N) or a list
+seeds = 10                        # a count (seeds 1..N) or a list (0 to 2**63 - 1)
 duration_s = 300                  # optional: overrides scenario.duration_s
 tables = false                    # keep each run's tables: false, true, or a list of names
 description = "..."               # optional, for the report
@@ -28,32 +28,43 @@ heatmaps = ["tasks_per_min"]       # optional: x by facet, a panel per hue value
 loglog = ["wall_us_per_robot_s"]  # optional: also drawn on log-log axes (x values > 0)
 ```
 
+The study decides each run's ``scenario.seed`` (from ``seeds``) and, with ``duration_s``,
+its ``scenario.duration_s``: a grid, case or override of those keys would be recorded in the
+results without being run, so it is refused. So are grids and cases over ``record`` keys
+that study runs ignore (they write no bag; ``tables`` decides the tables kept).
+
 Every combination is loaded as a scenario before the study starts, and its adapters check
-the sections they need together (:func:`cosim.runner.assembly.check_scenario`), so a bad key or
-value, or a combination that cannot run, in any of them is reported (file, key, value,
+the sections they need together (:mod:`cosim.studies.validate`), so a bad key or value, a
+combination that cannot run, or a report metric no run reports is named (file, key, value,
 expectation) and nothing runs.
 """
 
 from __future__ import annotations
 
 import itertools
+import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from cosim.core.errors import ConfigError
-from cosim.core.registry import AdapterRegistry
-from cosim.runner.assembly import adapter_names, check_scenario
-from cosim.runner.execute import execute
-from cosim.scenario import load_scenario
 from cosim.scenario.fields import show_name, show_value, suggest
 from cosim.scenario.loader import preset_names
 from cosim.scenario.tomlfile import read_toml_file
+from cosim.studies.reportspec import REPORT_KEYS, check_report, check_timeseries
+from cosim.studies.validate import validate_study
 
 SECTIONS = ("study", "grid", "overrides", "cases", "report")
 STUDY_KEYS = ("name", "scenario", "seeds", "duration_s", "tables", "description")
-REPORT_KEYS = ("x", "hue", "facet", "metrics", "heatmaps", "loglog", "timeseries")
-TIMESERIES_KEYS = ("table", "y", "where")
+SEED_MAX = 2**63 - 1
+"""Largest seed: results hold seeds as int64 (numpy's and Parquet's), and so do plans."""
+MAX_RUNS = 1_000_000
+"""Most runs a study may have (its plan is written out before the first run)."""
+NAME_PATTERN = re.compile(r"[\w.+-]{1,100}")
+"""A study name is one folder name: word characters, '.', '+', '-'; no separator."""
+IGNORED_IN_STUDIES = ("record.bag", "record.topics", "record.compression", "record.tables")
+"""Keys study runs ignore: they write no bag, and ``[study] tables`` picks the tables kept."""
 
 
 @dataclass(frozen=True)
@@ -77,7 +88,7 @@ class StudySpec:
 
     Attributes:
         path: the study file.
-        name: study name.
+        name: study name (one safe folder name).
         scenario: preset name or absolute path of the scenario file.
         seeds: the seeds.
         duration_s: overrides ``scenario.duration_s`` when set.
@@ -155,6 +166,17 @@ def load_study(path: str | Path) -> StudySpec:
     Raises:
         ConfigError: naming the file, the section, the key, the value and what was expected.
     """
+    spec = read_study(path)
+    validate_study(spec)
+    return spec
+
+
+def read_study(path: str | Path) -> StudySpec:
+    """Read a study file and check its structure and values, without loading scenarios.
+
+    Raises:
+        ConfigError: naming the file, the section, the key, the value and what was expected.
+    """
     path = Path(path)
     if not path.is_file():
         raise ConfigError(f"{path}: study file not found")
@@ -171,24 +193,14 @@ def load_study(path: str | Path) -> StudySpec:
     for key in ("name", "scenario"):
         if not isinstance(study.get(key), str) or not study[key]:
             raise _fail(path, "study", f"{key} = {study.get(key)!r}: expected a non-empty string")
-    scenario = study["scenario"]
-    if scenario not in preset_names():
-        candidate = (path.parent / scenario).resolve()
-        if not candidate.is_file():
-            raise _fail(
-                path,
-                "study",
-                f"scenario = {scenario!r}: expected a preset "
-                f"({', '.join(preset_names())}) or a file next to the study",
-            )
-        scenario = str(candidate)
+    name = _name(path, study["name"])
+    scenario = _scenario(path, study["scenario"])
     seeds = _seeds(path, study.get("seeds", 1))
-    duration = study.get("duration_s")
-    if duration is not None and (
-        isinstance(duration, bool) or not isinstance(duration, int | float) or duration <= 0
-    ):
-        raise _fail(path, "study", f"duration_s = {duration!r}: expected a number > 0")
+    duration = _duration(path, study.get("duration_s"))
     tables = _tables(path, study.get("tables", False))
+    description = study.get("description", "")
+    if not isinstance(description, str):
+        raise _fail(path, "study", f"description = {description!r}: expected a string")
     grid = _dotted(path, "grid", raw.get("grid", {}))
     for key, values in grid.items():
         if not isinstance(values, list) or not values:
@@ -198,43 +210,97 @@ def load_study(path: str | Path) -> StudySpec:
     if not isinstance(cases_raw, list):
         raise _fail(path, "cases", "expected [[cases]] tables")
     cases = tuple(_dotted(path, f"cases[{i}]", case) for i, case in enumerate(cases_raw))
+    _check_study_set(path, duration, [("grid", grid), ("overrides", overrides)], cases)
+    _check_size(path, grid, cases, seeds)
     report = raw.get("report", {})
     if not isinstance(report, dict):
         raise _fail(path, "report", "expected a table")
     _check_keys(path, "report", report, REPORT_KEYS)
-    _check_report(path, report, grid, overrides, cases)
-    _check_timeseries(path, report.get("timeseries", []), tables)
-    spec = StudySpec(
+    check_report(path, report, grid, overrides, cases)
+    check_timeseries(path, report.get("timeseries", []), tables)
+    return StudySpec(
         path=path,
-        name=study["name"],
+        name=name,
         scenario=scenario,
         seeds=seeds,
-        duration_s=float(duration) if duration is not None else None,
+        duration_s=duration,
         tables=tables,
         grid=grid,
         overrides=overrides,
         cases=cases,
         report=report,
-        description=str(study.get("description", "")),
+        description=description,
     )
-    _validate_combinations(spec)
-    return spec
+
+
+def _name(path: Path, name: str) -> str:
+    """The study's name becomes a folder name: one path component, nothing to escape with."""
+    if not NAME_PATTERN.fullmatch(name) or not name.strip("."):
+        raise _fail(
+            path,
+            "study",
+            f"name = {name!r}: expected one folder name of up to 100 letters, digits, '_', "
+            "'-', '.' or '+' (no '/', no '..'), e.g. 'comm_sweep'",
+        )
+    return name
+
+
+def _scenario(path: Path, scenario: str) -> str:
+    if scenario in preset_names():
+        return scenario
+    try:
+        candidate = (path.parent / scenario).resolve()
+        found = candidate.is_file()
+    except (OSError, ValueError):  # a name too long, or with a NUL byte
+        found = False
+    if not found:
+        raise _fail(
+            path,
+            "study",
+            f"scenario = {scenario!r}: expected a preset "
+            f"({', '.join(preset_names())}) or a file next to the study",
+        )
+    return str(candidate)
 
 
 def _seeds(path: Path, value: Any) -> tuple[int, ...]:
     if isinstance(value, int) and not isinstance(value, bool):
-        if value < 1:
-            raise _fail(path, "study", f"seeds = {value}: expected a count >= 1 or a list")
+        if not 1 <= value <= MAX_RUNS:
+            raise _fail(
+                path, "study", f"seeds = {value}: expected a count from 1 to {MAX_RUNS:,} or a list"
+            )
         return tuple(range(1, value + 1))
-    if (
-        isinstance(value, list)
-        and value
-        and all(isinstance(s, int) and not isinstance(s, bool) and s >= 0 for s in value)
-    ):
+    if isinstance(value, list) and value and all(_is_int(s) for s in value):
+        if bad := [s for s in value if not 0 <= s <= SEED_MAX]:
+            raise _fail(
+                path,
+                "study",
+                f"seeds = {show_value(value)}: seed {bad[0]} is out of range; expected seeds "
+                f"from 0 to {SEED_MAX} (2**63 - 1, what numpy's int64 and Parquet hold)",
+            )
         if len(set(value)) != len(value):
-            raise _fail(path, "study", f"seeds = {value}: expected distinct seeds")
+            raise _fail(path, "study", f"seeds = {show_value(value)}: expected distinct seeds")
         return tuple(value)
-    raise _fail(path, "study", f"seeds = {value!r}: expected a count >= 1 or a list of seeds >= 0")
+    raise _fail(
+        path, "study", f"seeds = {show_value(value)}: expected a count >= 1 or a list of seeds >= 0"
+    )
+
+
+def _is_int(value: Any) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _duration(path: Path, value: Any) -> float | None:
+    if value is None:
+        return None
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, int | float)
+        or not math.isfinite(value)
+        or value <= 0
+    ):
+        raise _fail(path, "study", f"duration_s = {value!r}: expected a number > 0")
+    return float(value)
 
 
 def _tables(path: Path, value: Any) -> tuple[str, ...]:
@@ -247,130 +313,50 @@ def _tables(path: Path, value: Any) -> tuple[str, ...]:
     raise _fail(path, "study", f"tables = {value!r}: expected true, false or a list of table names")
 
 
-def _check_report(
+def _check_study_set(
     path: Path,
-    report: dict[str, Any],
-    grid: dict[str, Any],
-    overrides: dict[str, Any],
+    duration: float | None,
+    sections: list[tuple[str, dict[str, Any]]],
     cases: tuple[dict[str, Any], ...],
 ) -> None:
-    """Column names are strings, and a dotted one is a key the study sets.
+    """Refuse keys the study sets itself, or that its runs ignore, where they would vary.
 
-    Undotted names are summary metrics (or ``seed``), known only once runs finish; a metric
-    no run reports is noted in the report rather than failing a finished study.
+    Such a key would be a column of the results whose values no run used.
     """
-    study_keys = {*grid, *overrides, *(k for case in cases for k in case)}
-    for key in ("x", "hue", "facet"):
-        if key not in report:
-            continue
-        value = report[key]
-        if not isinstance(value, str) or not value:
-            raise _fail(path, "report", f"{key} = {value!r}: expected a column name")
-        if "." in value and value not in study_keys:
-            raise _fail(
-                path,
-                "report",
-                f"{key} = {value!r}: not a key this study sets (expected one of "
-                f"{', '.join(sorted(study_keys)) or 'none'}, or a summary metric)",
-            )
-    for key in ("metrics", "heatmaps", "loglog"):
-        value = report.get(key, [])
-        if not isinstance(value, list) or not all(isinstance(m, str) and m for m in value):
-            raise _fail(path, "report", f"{key} = {value!r}: expected a list of metric names")
-    if report.get("heatmaps") and not ("x" in report and "facet" in report):
-        raise _fail(path, "report", "heatmaps need x and facet (the heatmap's columns and rows)")
-    if report.get("loglog"):
-        _check_loglog_x(path, report, grid, overrides, cases)
+    places = [*sections, *((f"cases[{i}]", case) for i, case in enumerate(cases))]
+    for where, table in places:
+        for key, value in table.items():
+            if problem := _study_set_problem(key, duration, varied=where != "overrides"):
+                raise _fail(path, where, f"{key!r} = {show_value(value)}: {problem}")
 
 
-def _check_loglog_x(
+def _study_set_problem(key: str, duration: float | None, *, varied: bool) -> str | None:
+    if key == "scenario.seed":
+        return (
+            "the study sets every run's seed from [study] seeds; list the seeds there "
+            "instead (seeds = [1, 2, 3])"
+        )
+    if key == "scenario.duration_s" and duration is not None:
+        return (
+            f"[study] duration_s = {duration:g} sets every run's duration; drop one of the "
+            "two (without [study] duration_s, the runs take scenario.duration_s from here)"
+        )
+    if varied and key in IGNORED_IN_STUDIES:
+        return (
+            "study runs ignore it (they write no bag; [study] tables decides the tables "
+            "kept), so varying it would record values no run used"
+        )
+    return None
+
+
+def _check_size(
     path: Path,
-    report: dict[str, Any],
-    grid: dict[str, Any],
-    overrides: dict[str, Any],
+    grid: dict[str, list[Any]],
     cases: tuple[dict[str, Any], ...],
+    seeds: tuple[int, ...],
 ) -> None:
-    """Log-log figures need an x whose values the study sets to be numbers > 0.
-
-    An undotted x is a summary metric, checked when the report is drawn.
-    """
-    loglog = report["loglog"]
-    if "x" not in report:
-        raise _fail(path, "report", f"loglog = {loglog!r}: needs x (the horizontal log axis)")
-    x = report["x"]
-    places = [("grid", v) for v in grid.get(x, [])]
-    places += [("overrides", overrides[x])] if x in overrides else []
-    places += [(f"cases[{i}]", case[x]) for i, case in enumerate(cases) if x in case]
-    for where, value in places:
-        if isinstance(value, bool) or not isinstance(value, int | float) or value <= 0:
-            raise _fail(
-                path,
-                "report",
-                f"loglog = {loglog!r}: x = {x!r} is {value!r} in [{where}]; "
-                "expected numbers > 0 on a log axis",
-            )
-
-
-def _check_timeseries(path: Path, entries: Any, tables: tuple[str, ...]) -> None:
-    """Each ``[report] timeseries`` entry names a kept table, a column and a filter."""
-    if not isinstance(entries, list) or not all(isinstance(e, dict) for e in entries):
-        raise _fail(path, "report", f"timeseries = {entries!r}: expected a list of tables")
-    for i, entry in enumerate(entries):
-        _check_keys(path, f"report.timeseries[{i}]", entry, TIMESERIES_KEYS)
-        table, y, where = entry.get("table"), entry.get("y"), entry.get("where", {})
-        if not isinstance(table, str) or not isinstance(y, str) or not table or not y:
-            raise _fail(
-                path, f"report.timeseries[{i}]", f"table = {table!r}, y = {y!r}: expected names"
-            )
-        if "*" not in tables and table not in tables:
-            raise _fail(
-                path,
-                f"report.timeseries[{i}]",
-                f"table = {table!r}: expected one the study keeps ([study] tables = "
-                f"{list(tables)!r})",
-            )
-        if not isinstance(where, dict) or not all(
-            isinstance(v, str | int | float | bool) for v in where.values()
-        ):
-            raise _fail(
-                path, f"report.timeseries[{i}]", f"where = {where!r}: expected column = value"
-            )
-
-
-def _validate_combinations(spec: StudySpec) -> None:
-    """Load and check every combination: what it cannot run stops the study here.
-
-    A bad key or value, or a combination an adapter refuses
-    (:func:`cosim.runner.assembly.check_scenario`), is reported before any run.
-
-    When the study keeps named tables, one scenario per distinct set of adapters is also run
-    for a millisecond (adapters create some tables only when they finish), so a table no run
-    would produce is reported now rather than by every run.
-    """
-    origin = f"{spec.path} [grid/overrides/cases]"
-    registry = AdapterRegistry.from_entry_points()
-    named = [t for t in spec.tables if t != "*"]
-    checked: set[tuple[str, ...]] = set()
-    have: set[str] = set()
-    for combination in spec.combinations():
-        overrides = dict(combination)
-        if spec.duration_s is not None:
-            overrides["scenario.duration_s"] = spec.duration_s
-        scenario = load_scenario(spec.scenario, overrides, override_origin=origin)
-        try:
-            check_scenario(scenario, registry=registry)
-        except ConfigError as error:
-            shown = ", ".join(f"{k} = {show_value(v)}" for k, v in combination.items())
-            raise ConfigError(f"{origin} ({shown}): {error}") from None
-        if named and (names := tuple(adapter_names(scenario))) not in checked:
-            checked.add(names)
-            have |= set(execute(scenario.with_duration(0.001)).tables)
-    # a table some runs have is kept where it exists (a grid with and without people)
-    if missing := [t for t in named if t not in have]:
-        raise _fail(
-            spec.path,
-            "study",
-            f"tables = {list(spec.tables)!r}: no run of this study has "
-            f"{', '.join(map(repr, missing))} (expected some of "
-            f"{', '.join(sorted(have))})",
+    total = math.prod(len(values) for values in grid.values()) * max(len(cases), 1) * len(seeds)
+    if total > MAX_RUNS:
+        raise ConfigError(
+            f"{path}: {total:,} runs ([grid] x [[cases]] x seeds): expected at most {MAX_RUNS:,}"
         )

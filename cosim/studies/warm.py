@@ -1,14 +1,17 @@
-"""Imported by the study workers' fork server: load every compiled kernel once.
+"""Imported by the study workers' fork server: tie it to the study, load every kernel once.
 
-Study workers fork from a server process; whatever it has loaded, they start with. Running
-one tiny scenario here loads the numba kernels (lidar, planner, local controller, simplex)
-from their cache once, instead of once in every worker.
+Study workers fork from a server process; whatever it has loaded, they start with. First the
+server asks to die with the study that started it (:mod:`cosim.studies.lifeline`), so a
+study killed outright leaves nothing running. Then running one tiny scenario here loads the
+numba kernels (lidar, planner, local controller, simplex) from their cache once, instead of
+once in every worker.
 """
 
 from __future__ import annotations
 
 import cosim
 from cosim.runner.execute import execute
+from cosim.studies.lifeline import bind_fork_server
 
 _TINY = {
     "scenario.duration_s": 0.5,
@@ -20,4 +23,5 @@ _TINY = {
     "record.messages": False,
 }
 
+bind_fork_server()
 execute(cosim.load_scenario("warehouse-random", _TINY))

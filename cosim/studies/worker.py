@@ -16,7 +16,7 @@ from typing import Any
 
 from cosim.core.errors import CosimError
 from cosim.runner.execute import execute
-from cosim.scenario import load_scenario
+from cosim.scenario import Scenario, load_scenario
 from cosim.scenario.loader import dump_scenario
 
 VOLATILE_METRICS = (
@@ -79,10 +79,38 @@ def _cell(value: Any) -> Any:
     return value
 
 
-def failed(job: Job, error: str, wall_time_s: float) -> Outcome:
-    """The outcome of a run that did not finish: its row says why."""
+def run_overrides(
+    combination: dict[str, Any], *, seed: int | None, duration_s: float | None
+) -> dict[str, Any]:
+    """A combination's overrides with the keys the study itself sets (seed, duration)."""
+    overrides = dict(combination)
+    if seed is not None:
+        overrides["scenario.seed"] = seed
+    if duration_s is not None:
+        overrides["scenario.duration_s"] = duration_s
+    return overrides
+
+
+def job_scenario(job: Job) -> Scenario:
+    """The scenario a job runs (its ``scenario.toml`` is this, resolved).
+
+    Raises:
+        ConfigError: the scenario or an override is invalid.
+    """
+    overrides = run_overrides(job.overrides, seed=job.seed, duration_s=job.duration_s)
+    return load_scenario(job.scenario, overrides, override_origin="study")
+
+
+def row_cells(job: Job) -> dict[str, Any]:
+    """The columns of a job's row that the study sets: run_id, seed and every override."""
     row: dict[str, Any] = {"run_id": job.run_id, "seed": job.seed}
     row.update((key, _cell(value)) for key, value in job.overrides.items())
+    return row
+
+
+def failed(job: Job, error: str, wall_time_s: float) -> Outcome:
+    """The outcome of a run that did not finish: its row says why."""
+    row = row_cells(job)
     row.update(status="error", error=error, wall_time_s=round(wall_time_s, 4))
     return Outcome(row, "", {}, {})
 
@@ -91,19 +119,14 @@ def run_one(job: Job) -> Outcome:
     """Run one study run; failures come back as a row with status ``error``, never raise."""
     start = time.perf_counter()
     try:
-        overrides = dict(job.overrides)
-        overrides["scenario.seed"] = job.seed
-        if job.duration_s is not None:
-            overrides["scenario.duration_s"] = job.duration_s
-        scenario = load_scenario(job.scenario, overrides, override_origin="study")
+        scenario = job_scenario(job)
         result = execute(scenario)
     except CosimError as error:
         return failed(job, str(error), time.perf_counter() - start)
     except Exception as error:  # a bug in a run must not stop the study
         detail = "".join(traceback.format_exception_only(type(error), error)).strip()
         return failed(job, f"internal error: {detail}", time.perf_counter() - start)
-    row: dict[str, Any] = {"run_id": job.run_id, "seed": job.seed}
-    row.update((key, _cell(value)) for key, value in job.overrides.items())
+    row = row_cells(job)
     summary = result.summary
     for key, value in summary.items():
         if key not in ("scenario", "source", "seed"):
