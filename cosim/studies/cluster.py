@@ -62,11 +62,8 @@ def connect(address: str, timeout_s: float) -> Any:
         ConfigError: nothing answered within ``timeout_s``, or what answered is not a Dask
             scheduler.
     """
-    from distributed import Client
-
     try:
-        # distributed's Client carries no annotations
-        return Client(address, timeout=f"{timeout_s}s", set_as_default=False)  # type: ignore[no-untyped-call]
+        return _client_class()(address, timeout=f"{timeout_s}s", set_as_default=False)
     except (OSError, TimeoutError) as error:
         raise ConfigError(
             f"--scheduler {address}: no Dask scheduler answered within {timeout_s:g} s "
@@ -78,6 +75,29 @@ def connect(address: str, timeout_s: float) -> Any:
             f"({_one_line(error)}); expected the scheduler's address (port 8786 by default), "
             "not its dashboard's"
         ) from None
+
+
+def _client_class() -> Any:
+    """``distributed.Client``, made to fail quietly when it cannot connect.
+
+    A Client that fails to start keeps a connection that is broken or half-open; when it is
+    garbage-collected it closes itself, waits on that connection for twice its timeout and
+    prints "Exception ignored in ... TimeoutError" after the study's one line. Marked closed
+    when its start fails, it has nothing to wait for.
+    """
+    from distributed import Client
+
+    # distributed's Client carries no annotations
+    class QuietClient(Client):
+        def start(self, **kwargs: Any) -> None:
+            try:
+                super().start(**kwargs)  # type: ignore[no-untyped-call]
+            except BaseException:
+                self.status = "closed"
+                self._loop_runner.stop()  # type: ignore[no-untyped-call]
+                raise
+
+    return QuietClient
 
 
 def dask_outcomes(client: Any, jobs: list[Job], address: str) -> Iterator[Outcome]:

@@ -11,7 +11,8 @@ continues only the study that started the folder: the same runs (seeds, override
 duration, tables) of the same resolved scenario and the same files it reads
 (:func:`fingerprint`). If ``plan.json`` is lost or garbled, the finished runs are the
 evidence: each one's row and ``scenario.toml`` must be what this study would run, and then
-the plan is written again. A run whose ``row.json`` cannot be read is run again.
+the plan is written again. A run whose ``row.json`` cannot be read, or is not the planned
+run's (its seed or an override differs), is run again.
 """
 
 from __future__ import annotations
@@ -169,7 +170,7 @@ def read_row(path: Path) -> _Found:
         return _Found(None, f"{ROW_FILE} cannot be read ({error})")
     try:
         row = json.loads(text)
-    except ValueError:
+    except (ValueError, RecursionError):  # RecursionError: nested deeper than Python's stack
         return _Found(None, f"{ROW_FILE} is not valid JSON")
     if (
         not isinstance(row, dict)
@@ -197,7 +198,7 @@ def _read_plan(path: Path) -> tuple[dict[str, Any] | None, str]:
         plan = json.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
         return None, "is missing"
-    except (OSError, UnicodeDecodeError, ValueError):
+    except (OSError, UnicodeDecodeError, ValueError, RecursionError):
         return None, "is garbled"
     if not isinstance(plan, dict) or not isinstance(plan.get("runs"), list):
         return None, "is garbled"
@@ -238,7 +239,14 @@ def inspect(spec: StudySpec, out: Path, *, resume: bool) -> FolderState:
         raise ConfigError(_changed(spec, out, what, finished))
     if old is not None and isinstance(old.get("fingerprint"), dict):
         _check_fingerprint(spec, out, old["fingerprint"], plan["fingerprint"], finished)
-        done = {run_id for run_id in finished if run_id in planned}
+        done = set()
+        for run_id in (r for r in finished if r in planned):
+            if bad := _unlike(finished[run_id], row_cells(job_of(spec, planned[run_id]))):
+                notes.append(
+                    f"{out / RUNS_DIR / run_id} {ROW_FILE} has {bad}: running {run_id} again"
+                )
+            else:
+                done.add(run_id)
     else:
         done, unverified = _verify(spec, out, finished)
         notes += unverified
@@ -356,13 +364,8 @@ def _verify(
         if run is None:
             what = f"finished run {run_id} is not one of this study's runs"
             raise ConfigError(_changed(spec, out, what, finished))
-        expected = row_cells(job_of(spec, run))
-        if bad := [k for k, v in expected.items() if _canonical(row.get(k)) != _canonical(v)]:
-            what = (
-                f"finished run {run_id} has {bad[0]} = {_canonical(row.get(bad[0]))}, the "
-                f"study {_canonical(expected[bad[0]])}"
-            )
-            raise ConfigError(_changed(spec, out, what, finished))
+        if bad := _unlike(row, row_cells(job_of(spec, run))):
+            raise ConfigError(_changed(spec, out, f"finished run {run_id} has {bad}", finished))
         change = _scenario_change(spec, out, run)
         if change is None:
             notes.append(
@@ -375,6 +378,14 @@ def _verify(
             raise ConfigError(_changed(spec, out, what, finished))
         done.add(run_id)
     return done, notes
+
+
+def _unlike(row: dict[str, Any], expected: dict[str, Any]) -> str:
+    """``key = value, the study other`` for the first cell of a row unlike the run's, or ""."""
+    for key, value in expected.items():
+        if _canonical(row.get(key)) != _canonical(value):
+            return f"{key} = {_canonical(row.get(key))}, the study {_canonical(value)}"
+    return ""
 
 
 def _write_text(path: Path, text: str) -> None:

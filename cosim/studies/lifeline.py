@@ -14,17 +14,15 @@ SIGTERM (and SIGHUP, a closed terminal) stop a study the way Ctrl-C does
 from __future__ import annotations
 
 import contextlib
-import ctypes
 import os
 import signal
-import sys
 import threading
 import time
 from collections.abc import Iterator
 from types import FrameType
 
-PR_SET_PDEATHSIG = 1
-"""``prctl`` option: the signal this process gets when its parent thread dies (Linux)."""
+from cosim.core.processes import die_with_parent
+
 STUDY_PID_VARIABLE = "COSIM_STUDY_PID"
 """Environment variable naming the study process, for its fork server."""
 WATCH_PERIOD_S = 1.0
@@ -82,21 +80,6 @@ def stop_on_signals() -> Iterator[None]:
     finally:
         for sig, handler in previous.items():
             signal.signal(sig, handler)
-
-
-def die_with_parent(sig: int = signal.SIGKILL) -> bool:
-    """Ask Linux to send ``sig`` to this process when its parent dies.
-
-    Returns:
-        Whether the kernel took it (False off Linux, or without ``prctl``).
-    """
-    if not sys.platform.startswith("linux"):
-        return False
-    try:
-        libc = ctypes.CDLL(None, use_errno=True)
-        return int(libc.prctl(PR_SET_PDEATHSIG, int(sig), 0, 0, 0)) == 0
-    except (OSError, AttributeError):
-        return False
 
 
 def alive(pid: int) -> bool:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -138,9 +139,12 @@ def add_derived_metrics(study_dir: Path, names: Sequence[str]) -> list[str]:
             added.append(name)
     if added:
         path = Path(study_dir) / RESULTS_FILE
+        partial = path.with_name(path.name + ".partial")  # a full disk keeps the old file
         try:
-            results.to_parquet(path, index=False)
+            results.to_parquet(partial, index=False)
+            os.replace(partial, path)
         except OSError as error:
+            partial.unlink(missing_ok=True)
             raise ExportError(f"{path}: cannot write: {error.strerror or error}") from None
     return added
 

@@ -82,9 +82,11 @@ def _local(jobs: list[Job], workers: int) -> Iterator[Outcome]:
 
 def _kill_workers(pool: ProcessPoolExecutor) -> None:
     """Stop a pool now: queued runs cancelled, the runs under way killed."""
+    # taken before shutdown, which forgets them: killed after it, the workers would finish
+    # their runs first (and the interpreter's exit would wait for them)
+    processes: dict[int, Any] = dict(getattr(pool, "_processes", None) or {})
     pool.shutdown(wait=False, cancel_futures=True)
-    processes: dict[int, Any] = getattr(pool, "_processes", None) or {}
-    for process in list(processes.values()):
+    for process in processes.values():
         process.kill()
 
 
@@ -148,7 +150,10 @@ def run_study(
     finally:
         if client is not None:
             client.close()
-    results = collect(spec, out)
+    try:
+        results = collect(spec, out)
+    except ExportError as error:  # every run is written: --resume only collects them
+        raise ExportError(_kept_message(spec, out, error, len(finished_rows(spec, out)))) from None
     if report and spec.report and len(results):
         from cosim.studies.reporting import report_study
 
@@ -167,12 +172,7 @@ def _write_outcomes(
                 progress(outcome)
     except (WorkerError, ExportError) as error:
         _close(outcomes)
-        kept = _keep(spec, out)
-        raise type(error)(
-            f"{spec.name}: {error}; the {kept} finished runs are kept in {out}: "
-            + ("free space or fix the folder, then " if isinstance(error, ExportError) else "")
-            + "continue with --resume"
-        ) from None
+        raise type(error)(_kept_message(spec, out, error, _keep(spec, out))) from None
     except KeyboardInterrupt as stop:
         _close(outcomes)
         signum = stop.signum if isinstance(stop, StudyStopped) else signal.SIGINT
@@ -184,6 +184,15 @@ def _write_outcomes(
         ) from None
     finally:
         _close(outcomes)
+
+
+def _kept_message(spec: StudySpec, out: Path, error: CosimError, kept: int) -> str:
+    """The line for a study cut short by ``error``: what happened, what is kept, what next."""
+    return (
+        f"{spec.name}: {error}; the {kept} finished runs are kept in {out}: "
+        + ("free space or fix the folder, then " if isinstance(error, ExportError) else "")
+        + "continue with --resume"
+    )
 
 
 def _close(outcomes: Iterator[Outcome]) -> None:
