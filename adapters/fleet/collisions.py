@@ -158,9 +158,10 @@ class CollisionsAdapter:
             self.collisions += 1
 
     def finish(self, run: RunContext) -> Mapping[str, Any]:
-        """Collisions, near misses and the smallest clearance (m)."""
+        """Collisions, near misses and the smallest clearance (m; None if never checked)."""
+        least = float(self.min_clearance_m)
         return {
             "collisions": self.collisions,
             "near_misses": self.near_misses,
-            "min_clearance_m": round(float(self.min_clearance_m), 6),
+            "min_clearance_m": round(least, 6) if np.isfinite(least) else None,
         }

@@ -85,9 +85,20 @@ class MappingConfig:
     )
 
     def problems(self) -> Iterator[Problem]:
-        """A map finer than 1 cm would be very large; rebuilt maps cannot be sent as updates."""
+        """Refuse settings that cannot work together.
+
+        A map finer than 1 cm would be very large; rebuilt maps cannot be sent as updates;
+        robots that do not map share nothing.
+        """
         if self.resolution_m < 0.01:
             yield Problem("resolution_m", self.resolution_m, "a cell size >= 0.01 m")
+        if not self.enabled and self.share != "none":
+            yield Problem(
+                "share",
+                self.share,
+                "'none' with enabled = false (robots that do not map have nothing to share); "
+                "or set mapping.enabled = true",
+            )
         if self.loop_closure and self.share == "maps":
             yield Problem(
                 "loop_closure",

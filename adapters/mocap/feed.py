@@ -2,31 +2,41 @@
 
 The library speaks to Vicon, OptiTrack, Qualisys, VRPN and other systems (whatever its
 build supports) and offers a ``mock`` backend whose rigid bodies are given as
-``name(x,y,z,qw,qx,qy,qz);...``. A daemon thread waits for frames and keeps, per tracked
-body, the poses in arrival order, stamped with the wall clock when the frame came in; the
-simulation drains them from its own thread. Occluded bodies (NaN positions) are counted
-and skipped.
+``name(x,y,z,qw,qx,qy,qz);...``. Its calls block in C++ holding the GIL (a Vicon server
+that refuses the connection is retried forever), so the connection lives in a process of
+its own (:mod:`adapters.mocap.feed_worker`): the run's process only reads lines from a
+pipe, on a daemon thread, and can always give up on the system, stop on Ctrl-C and kill
+the worker. Per tracked body the poses are kept in arrival order, stamped with the wall
+clock when the frame came in; the simulation drains them from its own thread. Occluded
+bodies (NaN positions) are counted and skipped.
 """
 
 from __future__ import annotations
 
+import json
 import math
+import subprocess
+import sys
+import tempfile
 import threading
-import time
 from collections import deque
 from collections.abc import Sequence
+from pathlib import Path
 from types import TracebackType
+from typing import IO, Any
 
-import motioncapture
-
+from adapters.mocap import feed_worker
+from adapters.mocap.settings import SYSTEMS
 from cosim.core.errors import BridgeError
 from models.mapping.se2 import yaw_of_quaternion
 
-SYSTEMS = ("vicon", "optitrack", "qualisys", "vrpn", "mock")
-"""Backends the motioncapture 1.1 wheel supports (others: "Unknown motion capture type!")."""
+__all__ = ["SYSTEMS", "MotionCaptureFeed", "mock_bodies", "quaternion_yaw"]
 
 BUFFER = 4096
 """Poses kept between two drains; older ones are dropped and counted."""
+
+STOP_WAIT_S = 0.5
+"""How long a closed feed's worker gets to end on SIGTERM before it is killed (s)."""
 
 Sample = tuple[int, str, float, float, float]
 """(wall-clock ns, body, x_m, y_m, yaw_rad) in the mocap system's frame."""
@@ -48,16 +58,19 @@ def mock_bodies(poses: dict[str, tuple[float, float, float]]) -> str:
 
 
 class MotionCaptureFeed:
-    """Rigid-body poses from a live mocap system, gathered on a background thread.
+    """Rigid-body poses from a live mocap system, read from a worker process.
+
+    Connecting does not wait: :attr:`connected`, :attr:`frames` and :meth:`failure` say
+    how far the system got, so the caller decides how long to wait for it.
 
     Args:
-        system: the backend (``vicon``, ``optitrack``, ``qualisys``, ``vrpn``, ``mock``, ...).
+        system: the backend (``vicon``, ``optitrack``, ``qualisys``, ``vrpn``, ``mock``).
         hostname: the mocap server's address ("" for the backend's default).
         bodies: the rigid bodies to keep.
         options: further backend options (e.g. ``rigid_bodies`` for ``mock``).
 
     Raises:
-        BridgeError: unknown backend, or the system cannot be reached.
+        BridgeError: an unknown backend, or the worker process cannot be started.
     """
 
     def __init__(
@@ -68,56 +81,103 @@ class MotionCaptureFeed:
         bodies: Sequence[str],
         options: dict[str, str] | None = None,
     ) -> None:
-        config = dict(options or {})
-        if hostname:
-            config["hostname"] = hostname
-        try:
-            self._mocap = motioncapture.connect(system, config)
-        except Exception as error:  # the library raises RuntimeError with a short text
-            where = f" at {hostname!r}" if hostname else ""
+        self.system = system
+        self.hostname = hostname
+        if system not in SYSTEMS:
             raise BridgeError(
-                f"motion capture {system!r}{where}: {error} (expected one of "
-                f"{', '.join(SYSTEMS)}, as this build of motioncapture supports, and a "
-                "reachable server)"
-            ) from None
+                f"motion capture {system!r}{self._at()}: unknown system (expected one of "
+                f"{', '.join(SYSTEMS)}, as this build of motioncapture supports)"
+            )
         self.bodies = tuple(bodies)
-        self._wanted = set(self.bodies)
         self._seen: set[str] = set()
         self._buffer: deque[Sample] = deque()
         self._lock = threading.Lock()
-        self._stop = threading.Event()
+        self.connected = False
+        """Whether the system accepted the connection."""
         self.frames = 0
         self.occluded = 0
         self.overflow = 0
-        self._thread = threading.Thread(target=self._loop, name=f"mocap-{system}", daemon=True)
+        self._failure: str | None = None
+        self._closed = False
+        # the worker's standard error, quoted when it fails; closed by close()
+        self._stderr: IO[bytes] = tempfile.TemporaryFile()  # noqa: SIM115
+        command = [
+            sys.executable,
+            "-P",
+            str(Path(feed_worker.__file__)),
+            system,
+            hostname,
+            json.dumps(list(self.bodies)),
+            json.dumps(dict(options or {})),
+        ]
+        try:
+            self._process = subprocess.Popen(
+                command,
+                stdin=subprocess.DEVNULL,
+                stdout=subprocess.PIPE,
+                stderr=self._stderr,
+                start_new_session=True,  # Ctrl-C at the terminal is the run's to handle
+            )
+        except OSError as error:
+            self._stderr.close()
+            raise BridgeError(
+                f"motion capture {system!r}{self._at()}: cannot start its worker process ({error})"
+            ) from None
+        self._thread = threading.Thread(target=self._read, name=f"mocap-{system}", daemon=True)
         self._thread.start()
 
-    def _loop(self) -> None:
-        mocap = self._mocap
-        while not self._stop.is_set():
+    def _at(self) -> str:
+        return f" at {self.hostname!r}" if self.hostname else ""
+
+    def _read(self) -> None:
+        """Take the worker's lines until it ends (its pipe closes)."""
+        stdout = self._process.stdout
+        assert stdout is not None
+        for line in stdout:
             try:
-                mocap.waitForNextFrame()
-                bodies = mocap.rigidBodies
-            except Exception:  # a dropped connection ends the feed; stale poses stop robots
-                return
-            now = time.time_ns()
-            samples = []
-            for name, body in bodies.items():
-                if name not in self._wanted:
-                    continue
-                x, y = (float(v) for v in list(body.position)[:2])
-                q = body.rotation
-                if not all(math.isfinite(v) for v in (x, y, q.w, q.x, q.y, q.z)):
-                    self.occluded += 1
-                    continue
-                samples.append((now, name, x, y, quaternion_yaw(q.w, q.x, q.y, q.z)))
-            with self._lock:
-                self.frames += 1
-                self._seen.update(s[1] for s in samples)
-                self._buffer.extend(samples)
-                while len(self._buffer) > BUFFER:
-                    self._buffer.popleft()
-                    self.overflow += 1
+                record: dict[str, Any] = json.loads(line)
+            except ValueError:
+                continue  # not the worker's (nothing else writes there), never trusted
+            if "error" in record:
+                with self._lock:
+                    self._failure = str(record["error"])
+            elif record.get("connected"):
+                self.connected = True
+            else:
+                self._frame(record)
+        code = self._process.wait()
+        with self._lock:
+            if self._failure is None and not self._closed:
+                self._failure = f"its worker process ended (status {code}){self._said()}"
+
+    def _frame(self, record: dict[str, Any]) -> None:
+        now = int(record["t"])
+        samples = [
+            (now, str(name), float(x), float(y), float(yaw)) for name, x, y, yaw in record["poses"]
+        ]
+        with self._lock:
+            self.frames += 1
+            self.occluded += int(record["occluded"])
+            self._seen.update(s[1] for s in samples)
+            self._buffer.extend(samples)
+            while len(self._buffer) > BUFFER:
+                self._buffer.popleft()
+                self.overflow += 1
+
+    def _said(self) -> str:
+        """The worker's last line on standard error, quoted (or nothing)."""
+        self._stderr.seek(0)
+        lines = [
+            ln.strip()
+            for ln in self._stderr.read()[-2000:].decode(errors="replace").splitlines()
+            if ln.strip()
+        ]
+        return f": {lines[-1]!r}" if lines else ""
+
+    def failure(self) -> str | None:
+        """Why the feed delivers nothing more (the library's words), or None while it runs."""
+        with self._lock:
+            return self._failure
 
     def drain(self) -> list[Sample]:
         """The poses gathered since the last call, in arrival order."""
@@ -132,9 +192,23 @@ class MotionCaptureFeed:
             return [b for b in self.bodies if b not in self._seen]
 
     def close(self) -> None:
-        """Stop the thread (it ends after the frame it is waiting for)."""
-        self._stop.set()
+        """End the worker (SIGTERM, then SIGKILL) and the reading thread."""
+        with self._lock:
+            if self._closed:
+                return
+            self._closed = True
+        process = self._process
+        if process.poll() is None:
+            process.terminate()
+            try:
+                process.wait(timeout=STOP_WAIT_S)
+            except subprocess.TimeoutExpired:
+                process.kill()
+                process.wait()
         self._thread.join(timeout=1.0)
+        if process.stdout is not None:
+            process.stdout.close()
+        self._stderr.close()
 
     def __enter__(self) -> MotionCaptureFeed:
         return self

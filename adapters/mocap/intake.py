@@ -3,9 +3,16 @@
 Measured poses come from the simulated motion capture, a replayed recording, a live mocap
 system or a real robot over DDS. Each goes through the same checks, as a robot's
 localization would apply them: the values must be a pose (finite numbers), the stamp must
-be newer than the last accepted one, and the displacement must be one the robot can drive
-in the time between the two stamps (:class:`models.mocap.gate.PoseGate`). A rejected pose
-is recorded (``tables/mocap``) and dropped; an accepted one is published on
+be newer than the last accepted one, the pose must lie in the world (the room and its
+walls, ``world.size_m`` and ``world.wall_thickness_m``: a tracked body outside it is not
+where the robot can be, and no map covers it), and the displacement must be one the robot
+can drive in the time between the two stamps (:class:`models.mocap.gate.PoseGate`). A
+rejected pose is recorded (``tables/mocap``) and dropped; poses outside the world are
+recorded once when a robot's poses leave it and once when they come back (``off_map`` /
+``on_map`` in ``tables/mocap``, ``pose_off_map`` / ``pose_on_map`` events), all of them
+counted (``mocap_rejected_off_map``). A dropped pose leaves the robot with its last good
+one, which goes stale after ``mocap.max_age_ms``: its navigation stops it (and a twin
+stays where it was last seen). An accepted one is published on
 ``/<robot>/pose`` (``geometry_msgs/PoseStamped`` in ``map``) and, for a twin, becomes its
 ground truth.
 """
@@ -22,7 +29,7 @@ from cosim.core.adapter import RunContext
 from cosim.core.hosts import HostId
 from cosim.core.messages import PoseStamped
 from cosim.core.timebase import NS_PER_S
-from cosim.scenario.sections import RobotsConfig
+from cosim.scenario.sections import RobotsConfig, WorldConfig
 from models.kinematics import FleetState
 from models.mocap.gate import PoseGate
 
@@ -61,6 +68,13 @@ class PoseIntake:
         self.last_stamp_ns = [0] * n
         self.has_last = [False] * n
         self.records = MocapRecords.of(run)
+        self.recorder = run.recorder
+        world = run.settings(WorldConfig)
+        wall = world.wall_thickness_m
+        self.world_m = (-wall, -wall, world.size_m[0] + wall, world.size_m[1] + wall)
+        """(xmin, ymin, xmax, ymax) of the world in ``map`` (m): the room and its walls."""
+        self.off_map = [False] * n
+        """Whether robot i's latest pose lay outside the world."""
         self.mirrors = run.service(Mirrors)
         self.topics = [pose_topic(name) for name in self.names]
         self._advertised: set[int] = set()
@@ -103,6 +117,8 @@ class PoseIntake:
         if not all(math.isfinite(v) for v in (x_m, y_m, yaw_rad)):
             self.records.row(now, name, "invalid", f"pose ({x_m}, {y_m}, {yaw_rad})")
             return False
+        if not self._in_world(now, index, x_m, y_m):
+            return False
         last = self.last[index] if self.has_last[index] else None
         verdict = self.gate.check_one(
             last, self.last_stamp_ns[index], (x_m, y_m, yaw_rad), stamp_ns
@@ -130,3 +146,26 @@ class PoseIntake:
             self.host if host is None else host,
         )
         return True
+
+    def _in_world(self, now_ns: int, index: int, x_m: float, y_m: float) -> bool:
+        """Whether the pose lies in the world; leaving it and coming back recorded once."""
+        xmin, ymin, xmax, ymax = self.world_m
+        inside = xmin <= x_m <= xmax and ymin <= y_m <= ymax
+        if inside == (not self.off_map[index]):
+            if not inside:
+                self.records.count("off_map_poses")
+            return inside
+        name = self.names[index]
+        self.off_map[index] = not inside
+        where = f"pose ({x_m:.2f}, {y_m:.2f}) m"
+        if inside:
+            detail = f"{where}: back in the world"
+            self.records.row(now_ns, name, "on_map", detail)
+            self.recorder.event(now_ns, name, "pose_on_map", detail)
+            return True
+        world = f"[{xmin:g}, {xmax:g}] x [{ymin:g}, {ymax:g}] m"
+        detail = f"{where} outside the world {world}: rejected, the robot holds its last pose"
+        self.records.row(now_ns, name, "off_map", detail)
+        self.recorder.event(now_ns, name, "pose_off_map", detail)
+        self.records.count("off_map_poses")
+        return False

@@ -4,6 +4,11 @@ Both are polled from the kernel (no callback runs on another thread's time): eac
 takes what arrived since the last one and maps its wall-clock stamps to kernel time with
 the real-time kernel's clock. Nothing received is trusted: samples that are not a pose
 are counted and dropped here, the rest go through the pose intake's checks.
+
+Nothing here waits for the system: the mocap adapter asks each poll whether the source
+failed (:meth:`LiveSource.failure`) and, once ``mocap.connect_timeout_s`` has passed
+without a pose of some tracked robot, ends the run with :class:`LiveSourceError` saying
+what the source got that far (:meth:`LiveSource.silence`).
 """
 
 from __future__ import annotations
@@ -17,10 +22,15 @@ from adapters.ros2dds.session import dds_session
 from adapters.ros2dds.types import PoseStamped as DdsPoseStamped
 from adapters.ros2dds.types import planar_pose
 from cosim.core.adapter import RunContext
+from cosim.core.errors import BridgeError
 from models.kinematics import FleetState
 
 Sample = tuple[int, int, float, float, float]
 """(robot index, stamp in kernel ns, x_m, y_m, yaw_rad) in ``map``."""
+
+
+class LiveSourceError(BridgeError):
+    """A live pose source failed, or sent no pose of a tracked robot in time."""
 
 
 class LiveSource(Protocol):
@@ -38,17 +48,28 @@ class LiveSource(Protocol):
         """Counts for the run's summary."""
         ...
 
+    def failure(self) -> str | None:
+        """Why the source delivers nothing more (one line), or None while it may."""
+        ...
+
+    def silence(self, index: int) -> str:
+        """What was listened to for robot ``index``, and what came (for an error line)."""
+        ...
+
 
 class MotionCaptureSource:
     """Rigid bodies of a live mocap system, one per tracked robot."""
 
     def __init__(self, run: RunContext, cfg: MocapConfig, bodies: list[tuple[int, str]]) -> None:
         self.kernel = run.kernel
+        self.cfg = cfg
+        self.body = {index: body for index, body in bodies}
         self.index = {body: index for index, body in bodies}
+        fleet = run.service(FleetState)
+        self.names = list(fleet.names)
         options = {}
         if cfg.system == "mock":
             # a mock system holds each body where its robot starts (demos and tests)
-            fleet = run.service(FleetState)
             options["rigid_bodies"] = mock_bodies(
                 {body: (fleet.x[i], fleet.y[i], fleet.yaw[i]) for body, i in self.index.items()}
             )
@@ -73,12 +94,41 @@ class MotionCaptureSource:
         """Bodies never seen."""
         return {"mocap_missing_bodies": len(self.feed.missing_bodies())}
 
+    def where(self) -> str:
+        """``the vicon motion capture at '10.0.0.5'``."""
+        host = f" at {self.cfg.hostname!r}" if self.cfg.hostname else ""
+        return f"the {self.cfg.system} motion capture{host}"
+
+    def failure(self) -> str | None:
+        """The library's or the worker's last words, naming the system and its host."""
+        failure = self.feed.failure()
+        if failure is None:
+            return None
+        return f"{self.where()}: {failure}"
+
+    def silence(self, index: int) -> str:
+        """Not connected, connected but no frame, or frames without this robot's body."""
+        feed, waited = self.feed, f"{self.cfg.connect_timeout_s:g} s"
+        if not feed.connected:
+            return f"{self.where()} did not answer within {waited} (no connection)"
+        if feed.frames == 0:
+            return f"{self.where()} accepted the connection but sent no frame within {waited}"
+        occluded = f", {feed.occluded} times occluded" if feed.occluded else ""
+        return (
+            f"no pose of {self.names[index]} within {waited} from {self.where()}: "
+            f"listened for rigid body {self.body[index]!r} ({feed.frames} frames came, none "
+            f"with it{occluded})"
+        )
+
 
 class Ros2PoseSource:
     """PoseStamped topics over DDS, one per tracked robot (as ros2-vicon-receiver publishes)."""
 
-    def __init__(self, run: RunContext, bodies: list[tuple[int, str]]) -> None:
+    def __init__(self, run: RunContext, cfg: MocapConfig, bodies: list[tuple[int, str]]) -> None:
         self.kernel = run.kernel
+        self.cfg = cfg
+        self.names = list(run.service(FleetState).names)
+        self.topic = dict(bodies)
         self.session = dds_session(run)
         participant = self.session.participant
         self.subscriptions = [
@@ -111,6 +161,18 @@ class Ros2PoseSource:
             "mocap_dds_malformed": sum(s.malformed for _, s in self.subscriptions),
         }
 
+    def failure(self) -> str | None:
+        """DDS has no connection to lose: never."""
+        return None
+
+    def silence(self, index: int) -> str:
+        """The topic and the DDS domain listened on."""
+        return (
+            f"no pose of {self.names[index]} within {self.cfg.connect_timeout_s:g} s: listened "
+            f"for geometry_msgs/PoseStamped on {self.topic[index]} on {self.session.where()} "
+            "(mocap.source = 'ros2')"
+        )
+
 
 def open_live_source(
     run: RunContext, cfg: MocapConfig, bodies: list[tuple[int, str]]
@@ -118,4 +180,4 @@ def open_live_source(
     """Connect the live source ``cfg.source`` names."""
     if cfg.source == "motioncapture":
         return MotionCaptureSource(run, cfg, bodies)
-    return Ros2PoseSource(run, bodies)
+    return Ros2PoseSource(run, cfg, bodies)

@@ -10,16 +10,24 @@ plus the bridge, not a measured one.
 
 from __future__ import annotations
 
+import string
 from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import ClassVar, Literal
 
+from adapters.ros2dds.naming import dds_topic
 from cosim.scenario.fields import Problem, param
 
 MocapSource = Literal["none", "simulated", "bag", "motioncapture", "ros2"]
 
 EXTERNAL_SOURCES = ("bag", "motioncapture", "ros2")
 """Sources whose poses come from outside the simulation: they move the robots they track."""
+
+SYSTEMS = ("vicon", "optitrack", "qualisys", "vrpn", "mock")
+"""Backends the motioncapture 1.1 wheel supports (others: "Unknown motion capture type!")."""
+
+PATTERN_TOKENS = ("robot",)
+"""The ``{token}`` names ``topic_pattern`` may hold."""
 
 
 @dataclass(frozen=True)
@@ -74,7 +82,15 @@ class MocapConfig:
     topic_pattern: str = param(
         "/{robot}/pose",
         "ros2: the PoseStamped topic of each physical robot, {robot} standing for its name "
-        "(ros2-vicon-receiver publishes /vicon/<subject>/<segment>)",
+        "(the only token; ros2-vicon-receiver publishes /vicon/<subject>/<segment>)",
+    )
+    connect_timeout_s: float = param(
+        10.0,
+        "motioncapture, ros2: a live source that has not connected, or has sent no pose of "
+        "a tracked robot, this long after the run started ends the run with an error naming "
+        "the system, its host and the robot (s)",
+        gt=0,
+        le=3600,
     )
 
     def problems(self) -> Iterator[Problem]:
@@ -96,8 +112,49 @@ class MocapConfig:
         tracked = [robot for robot, _ in self.bodies]
         if len(set(tracked)) != len(tracked):
             yield Problem("bodies", [list(b) for b in self.bodies], "each robot tracked once")
+        yield from self._pattern_problems()
         if self.source == "ros2" and "{robot}" not in self.topic_pattern and not self.bodies:
             yield Problem("topic_pattern", self.topic_pattern, "a pattern containing {robot}")
+        if self.source == "ros2":
+            for robot, body in self.bodies:
+                reason = _topic_problem(body)
+                if reason is not None:
+                    yield Problem("bodies", [robot, body], f"a ROS 2 topic for ros2 ({reason})")
+        if self.source == "motioncapture":
+            if self.system not in SYSTEMS:
+                yield Problem("system", self.system, f"one of {', '.join(SYSTEMS)}")
+            elif self.system != "mock" and not self.hostname.strip():
+                yield Problem("hostname", self.hostname, f"the {self.system} server's address")
+            if any(c.isspace() for c in self.hostname):
+                yield Problem("hostname", self.hostname, "an address without spaces")
+
+    def _pattern_problems(self) -> Iterator[Problem]:
+        """``topic_pattern``: only known tokens, and a valid topic once they are filled in."""
+        known = ", ".join("{" + t + "}" for t in PATTERN_TOKENS)
+        try:
+            fields = list(string.Formatter().parse(self.topic_pattern))
+        except ValueError:  # a lone brace
+            yield Problem(
+                "topic_pattern", self.topic_pattern, f"braces only around a token ({known})"
+            )
+            return
+        for _text, name, spec, conversion in fields:
+            if name is None:
+                continue
+            if name not in PATTERN_TOKENS or spec or conversion:
+                token = "{" + name + ("!" + conversion if conversion else "")
+                token += (":" + spec if spec else "") + "}"
+                yield Problem(
+                    "topic_pattern",
+                    self.topic_pattern,
+                    f"only the tokens {known} (not {token})",
+                )
+                return
+        reason = _topic_problem(self.topic_pattern.replace("{robot}", "robot_1"))
+        if reason is not None:
+            yield Problem(
+                "topic_pattern", self.topic_pattern, f"a ROS 2 topic once filled in ({reason})"
+            )
 
     @property
     def external(self) -> bool:
@@ -111,3 +168,12 @@ class MocapConfig:
     def needs_realtime(self) -> bool:
         """A live system sends poses on the wall clock: the run must keep pace with it."""
         return self.source in ("motioncapture", "ros2")
+
+
+def _topic_problem(name: str) -> str | None:
+    """Why ``name`` is not an absolute ROS 2 topic, or None."""
+    try:
+        dds_topic(name)
+    except ValueError as error:
+        return str(error)
+    return None

@@ -9,7 +9,11 @@
   the first pose falls at time 0; the replayed robot is a twin that follows it.
 * ``motioncapture`` / ``ros2``: live poses (the ``motioncapture`` library, or PoseStamped
   topics over DDS) taken in at ``mocap.rate_hz``; stamps are wall clock, mapped to kernel
-  time by the real-time kernel; the tracked robots are twins.
+  time by the real-time kernel; the tracked robots are twins. The run never waits for the
+  system: a source that fails ends the run at once, and one that has sent no pose of some
+  tracked robot ``mocap.connect_timeout_s`` after the start ends it then
+  (:class:`~adapters.mocap.live.LiveSourceError`, one line naming the system, its host,
+  the robot and what was listened for; an event ``no_pose`` or ``mocap_failed``).
 
 Every pose goes through :class:`adapters.mocap.intake.PoseIntake` and is published on
 ``/<robot>/pose`` from the ``mocap`` host, so it crosses the network model to the robot.
@@ -25,7 +29,7 @@ import numpy as np
 import simpy
 
 from adapters.mocap.intake import PoseIntake
-from adapters.mocap.live import LiveSource, open_live_source
+from adapters.mocap.live import LiveSource, LiveSourceError, open_live_source
 from adapters.mocap.settings import MocapConfig
 from adapters.mocap.tables import MOCAP, MocapRecords
 from adapters.mocap.tracking import external_bodies, simulated_robots
@@ -36,7 +40,7 @@ from cosim.core.hosts import HostKind
 from cosim.core.kernel import Stage
 from cosim.core.recorder import TableSpec
 from cosim.core.rng import BlockDraws
-from cosim.core.timebase import ms_to_ns, period_ns
+from cosim.core.timebase import ms_to_ns, period_ns, s_to_ns
 from models.kinematics import FleetState
 from models.mocap.sampling import MocapParams, measure
 
@@ -63,8 +67,12 @@ class MocapAdapter:
         self.host = run.add_host(MOCAP_HOST, HostKind.MOCAP)
         self.intake = PoseIntake(run, self.host)
         self.records = MocapRecords.of(run)
+        self.recorder = run.recorder
         self.period_ns = period_ns(cfg.rate_hz)
         self.live: LiveSource | None = None
+        self._unheard: set[int] = set()
+        """Tracked robots of a live source with no pose yet."""
+        self._deadline_ns = 0
         self._live_summary: dict[str, Any] = {}
         self.tracks: list[tuple[int, PoseTrack]] = []
         if cfg.source == "simulated":
@@ -114,6 +122,8 @@ class MocapAdapter:
                 kernel.process(self._replay(run, index, track, t0))
         else:
             self.live = open_live_source(run, self.cfg, self.bodies)
+            self._unheard = set(self.tracked)
+            self._deadline_ns = kernel.now_ns + s_to_ns(self.cfg.connect_timeout_s)
             kernel.every(self.period_ns, self._take_live, stage=Stage.SENSING)
 
     # -- simulated --------------------------------------------------------------------
@@ -161,9 +171,39 @@ class MocapAdapter:
 
     # -- live -------------------------------------------------------------------------
     def _take_live(self, now_ns: int) -> None:
-        assert self.live is not None
-        for index, stamp_ns, x, y, yaw in self.live.take(now_ns):
+        """Take in what arrived; end the run on a failed or (at first) silent source.
+
+        Raises:
+            LiveSourceError: the source failed, or a tracked robot has had no pose
+                ``mocap.connect_timeout_s`` after the start.
+        """
+        live = self.live
+        assert live is not None
+        for index, stamp_ns, x, y, yaw in live.take(now_ns):
+            self._unheard.discard(index)
             self.intake.submit(index, stamp_ns, x, y, yaw, mirror=True, now_ns=now_ns)
+        failure = live.failure()
+        if failure is not None:
+            self.recorder.event(now_ns, MOCAP_HOST, "mocap_failed", failure)
+            raise LiveSourceError(f"{failure}; {self._expected()}")
+        if self._unheard and now_ns >= self._deadline_ns:
+            index = min(self._unheard)
+            text = live.silence(index)
+            self.recorder.event(now_ns, self.fleet.names[index], "no_pose", text)
+            raise LiveSourceError(f"{text}; {self._expected()}")
+
+    def _expected(self) -> str:
+        """What a live source needs, and the keys that say where it is."""
+        cfg = self.cfg
+        keys = (
+            "mocap.system, mocap.hostname and mocap.bodies"
+            if cfg.source == "motioncapture"
+            else "mocap.bodies or mocap.topic_pattern, and physical.dds_domain"
+        )
+        return (
+            f"expected a pose of every tracked robot within mocap.connect_timeout_s = "
+            f"{cfg.connect_timeout_s:g} s (see {keys})"
+        )
 
     def close(self) -> None:
         """Disconnect a live source (its counts are kept for the summary)."""

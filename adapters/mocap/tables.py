@@ -1,8 +1,9 @@
 """Motion-capture records: ``tables/mocap`` rows and the summary counts.
 
 Rows are the exceptions, not the stream: rejected poses (a jump beyond what the robot can
-drive, a stamp out of order, a sample that is not a pose) and the robots stopped because
-their newest pose was too old, and when they got a fresh one again.
+drive, a stamp out of order, a sample that is not a pose), a robot's poses leaving the
+world and coming back (one row each way, however many poses fell outside), and the robots
+stopped because their newest pose was too old, and when they got a fresh one again.
 """
 
 from __future__ import annotations
@@ -20,14 +21,15 @@ MOCAP = TableSpec(
     {
         "t_s": "when (s)",
         "robot": "the robot",
-        "event": "jump, out_of_order or invalid (a pose rejected), stale or fresh",
+        "event": "jump, out_of_order or invalid (a pose rejected), off_map (the first of "
+        "the poses outside the world, all rejected) or on_map (back inside), stale or fresh",
         "detail": "the particulars (the jump's size, the pose's age, ...)",
     },
     categorical=("robot", "event"),
 )
 MOCAP_COLUMNS = tuple(MOCAP.columns)
 
-EVENTS = ("jump", "out_of_order", "invalid", "stale", "fresh")
+EVENTS = ("jump", "out_of_order", "invalid", "off_map", "on_map", "stale", "fresh")
 """The events of ``tables/mocap``."""
 
 
@@ -72,5 +74,6 @@ class MocapRecords:
             "mocap_rejected_jumps": c["jump"],
             "mocap_rejected_out_of_order": c["out_of_order"],
             "mocap_invalid": c["invalid"],
+            "mocap_rejected_off_map": c["off_map_poses"],
             "mocap_stale_stops": c["stale"],
         }

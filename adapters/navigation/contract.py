@@ -91,6 +91,11 @@ class LocalController(Protocol):
 
     Attributes:
         name: the registered name (``navigation.controller``).
+
+    A controller may also set ``footprint_padding_m`` (m): the clearance beyond the
+    footprint it never gives up; the global planner then blocks every cell nearer an
+    obstacle than the footprint plus that (Nav2's ``footprint_padding``), so that it sends
+    no robot into a gap the controller will not enter. Without it, 0.
     """
 
     name: ClassVar[str]

@@ -19,7 +19,7 @@ from adapters.mapping.settings import MappingConfig
 from adapters.navigation.settings import NavigationConfig
 from cosim.core.adapter import RunContext
 from cosim.core.messages import OccupancyGrid as GridMessage
-from models.navigation.costmap import CostmapParams, StaticCostmap
+from models.navigation.costmap import INSCRIBED, CostmapParams, StaticCostmap
 from models.navigation.lanes import TWO_WAY, aisle_lanes
 from models.occupancy import (
     FREE,
@@ -155,3 +155,72 @@ def robot_layers(run: RunContext, static: StaticCostmap, robots: int) -> StaticL
     area = map_geometry(run.service(Warehouse), mapping.resolution_m)
     resolution_m = run.settings(NavigationConfig).resolution_m
     return StaticLayers.unexplored(unknown_grid(area), robots, static.params, resolution_m)
+
+
+def padded(static: StaticCostmap, padding_m: float) -> StaticCostmap:
+    """``static`` with every cell nearer an obstacle than the footprint plus a padding blocked.
+
+    Nav2's ``footprint_padding``, kept for the planner: the local controller keeps
+    ``padding_m`` of clearance beyond the footprint and will not enter a gap narrower than
+    the footprint plus that on both sides, so the global planner must not route through
+    one (a robot sent into a 0.82 m gap by a plan that fits a 0.66 m footprint halts at its
+    mouth, replanning the same way until it is stuck). The inflation costs outside that
+    band are unchanged.
+
+    Args:
+        static: the costmap (its ``distance_m`` grid is used).
+        padding_m: clearance beyond the footprint radius (m), >= 0.
+
+    Returns:
+        A costmap whose cells within ``robot_radius_m + padding_m`` of an obstacle are
+        ``INSCRIBED`` (lethal and unknown cells kept), or ``static`` itself for no padding.
+    """
+    if padding_m <= 0:
+        return static
+    reach = static.params.robot_radius_m + padding_m
+    cost = np.array(static.cost)
+    band = (static.distance_m <= reach) & (cost < INSCRIBED)
+    cost[band] = INSCRIBED
+    return StaticCostmap(
+        cost=cost,
+        distance_m=static.distance_m,
+        resolution_m=static.resolution_m,
+        origin_xy_m=static.origin_xy_m,
+        params=static.params,
+    )
+
+
+def open_goal(
+    cost: npt.NDArray[np.uint8],
+    plain: StaticCostmap,
+    padded_layer: StaticCostmap,
+    goal_xy_m: npt.NDArray[np.float64],
+    radius_m: float,
+) -> None:
+    """Give back, round a goal, the cells only the padding blocked (in place on ``cost``).
+
+    A goal nearer an obstacle than the footprint plus the padding is reached within the
+    goal tolerance all the same; the planner needs a way into it.
+
+    Args:
+        cost: a per-plan cost grid made from ``padded_layer``.
+        plain: the layer without padding.
+        padded_layer: the padded layer.
+        goal_xy_m: the goal in ``map`` (m).
+        radius_m: cells whose centre is this near the goal are opened (m).
+    """
+    res = plain.resolution_m
+    gx, gy = plain.world_to_cell(goal_xy_m)
+    reach = int(np.ceil(radius_m / res))
+    x0, x1 = max(gx - reach, 0), min(gx + reach + 1, plain.width)
+    y0, y1 = max(gy - reach, 0), min(gy + reach + 1, plain.height)
+    if x0 >= x1 or y0 >= y1:
+        return
+    dx = np.arange(x0, x1) - gx
+    dy = np.arange(y0, y1) - gy
+    disc = (dx[None, :] ** 2 + dy[:, None] ** 2) * res * res <= radius_m * radius_m
+    window = cost[y0:y1, x0:x1]
+    before = plain.cost[y0:y1, x0:x1]
+    after = padded_layer.cost[y0:y1, x0:x1]
+    band = disc & (after != before) & (window == after)
+    window[band] = before[band]

@@ -24,6 +24,9 @@ class DwaControl:
         self.limits = context.limits
         self.radii_m = context.radii_m
         self.params = DwaParams(control_period_s=1.0 / context.control_hz)
+        self.footprint_padding_m = self.params.safety_margin_m
+        """DWA admits no trajectory closer than this beyond the footprint (m): the global
+        planner keeps its paths out of gaps narrower than that on both sides."""
 
     def commands(self, inputs: ControlInputs) -> tuple[FloatArray, FloatArray, BoolArray]:
         """Speeds (m/s), yaw rates (rad/s), and the robots that found nothing admissible."""

@@ -18,7 +18,7 @@ import time
 import numpy as np
 
 from adapters.navigation.contract import GlobalPlanner, PlanRequest, RepairRequest
-from adapters.navigation.layers import StaticLayers
+from adapters.navigation.layers import StaticLayers, open_goal
 from adapters.navigation.robots_layer import RobotsLayer
 from adapters.navigation.scan_memory import MovingMemory, ScanMemory
 from adapters.navigation.tables import NavRecords
@@ -38,6 +38,11 @@ PATH_CLEARANCE_M = 0.3
 """A moving thing closer than footprint plus this to the path ahead calls for a replan (m)."""
 REPAIR_DETOUR_M = 2.0
 """A repair lengthening the way by more than this is checked against a full replan (m)."""
+GOAL_OPENING_M = 0.15
+"""Beyond the padding, how far round a goal in the padding its cells are opened (m): more
+than a diagonal cell of the default 0.1 m costmap, so that the goal joins free space."""
+OFF_MAP = "off the map"
+"""Why a robot whose pose lies outside its costmap got no plan."""
 Found = tuple[tuple[np.ndarray, float] | None, str, np.ndarray]
 """A plan's outcome: the route ``(waypoints, length_m)`` or None, how it was found, and the
 moving things planned round."""
@@ -50,6 +55,9 @@ class GlobalPlanning:
         planner: the global planner.
         static: the static layer every robot shares (the building's map).
         layers: each robot's static layer (the shared one, or the map it builds).
+        plan_layers: the layers plans are made on: ``layers`` with the controller's
+            footprint padding (:func:`adapters.navigation.layers.padded`), or ``layers``.
+        padding_m: that padding (m).
         lanes: one-way lanes on the layers' cells (``traffic = "lanes"``), or None.
         memory: the scans each robot keeps.
         moving: the moving things each robot remembers.
@@ -73,6 +81,8 @@ class GlobalPlanning:
         planner: GlobalPlanner,
         static: StaticCostmap,
         layers: StaticLayers,
+        plan_layers: StaticLayers,
+        padding_m: float,
         lanes: np.ndarray | None,
         memory: ScanMemory,
         moving: MovingMemory,
@@ -91,6 +101,8 @@ class GlobalPlanning:
         self.planner = planner
         self.static = static
         self.layers = layers
+        self.plan_layers = plan_layers
+        self.padding_m = padding_m
         self.lanes = lanes
         self.memory = memory
         self.moving = moving
@@ -157,8 +169,19 @@ class GlobalPlanning:
         self.finish(run, i, now_ns, found, started, replan=replan)
         return found[0] is not None
 
+    def off_map(self, i: int) -> bool:
+        """Whether robot ``i``'s pose lies outside its costmap (no plan can start there)."""
+        layer = self.layers[i]
+        return not layer.in_bounds(layer.world_to_cell(self.pose[i, :2]))
+
     def route(self, i: int, now_ns: int, *, replan: bool) -> Found:
-        """A new route for robot ``i`` (:data:`Found`), not followed yet."""
+        """A new route for robot ``i`` (:data:`Found`), not followed yet.
+
+        None for a robot whose pose is off its costmap (``detail`` says so): it is told
+        to stop (:meth:`off_map`), never planned from outside the grid.
+        """
+        if self.off_map(i):
+            return None, OFF_MAP, np.zeros((0, 2))
         points, discs = self._obstacles(i, now_ns)
         layer = self.layers[i]
         # a robot mapping as it goes plans in full: the rest of its old path was planned on
@@ -194,6 +217,10 @@ class GlobalPlanning:
             self._set_path(run, i, now_ns, route[0], points)
         else:
             self.next_plan_ns[i] = now_ns + self.replan_ns
+            if detail == OFF_MAP:
+                # a path to follow from where the robot is not, perhaps to an old goal:
+                # none; it plans afresh once back on the map
+                self.paths.clear(i)
         self.records.row(
             now_ns,
             i,
@@ -202,7 +229,7 @@ class GlobalPlanning:
             self.goal[i, 1],
             path_length_m=route[1] if route is not None else math.nan,
             plan_ms=(time.perf_counter() - started) * 1e3,
-            detail=detail if route is not None else "no path",
+            detail=detail if route is not None or detail == OFF_MAP else "no path",
         )
 
     def _repair(
@@ -210,7 +237,7 @@ class GlobalPlanning:
     ) -> tuple[np.ndarray, float] | None:
         """The path with its stretch ahead replanned, or None."""
         request = RepairRequest(
-            layer,
+            self.plan_layers[i],
             points,
             discs if len(discs) else None,
             self.paths.waypoints(i),
@@ -223,8 +250,17 @@ class GlobalPlanning:
     def _full(
         self, i: int, layer: StaticCostmap, points: np.ndarray, discs: np.ndarray
     ) -> tuple[np.ndarray, float] | None:
-        """A path from the robot to its goal over the whole map, or None."""
-        cost = with_obstacles(layer, points, discs=discs if len(discs) else None)
+        """A path from the robot to its goal over the whole map, or None.
+
+        Searched on the padded costs (:func:`adapters.navigation.layers.padded`) with a
+        way into a goal that lies in the padding; ``layer`` (the unpadded one) gives the
+        grid's geometry and, on the building's map, the planner's landmark bounds (the
+        padded costs are never below it).
+        """
+        plan_layer = self.plan_layers[i]
+        cost = with_obstacles(plan_layer, points, discs=discs if len(discs) else None)
+        if plan_layer is not layer:
+            open_goal(cost, layer, plan_layer, self.goal[i], GOAL_OPENING_M + self.padding_m)
         request = PlanRequest(layer, cost, self.pose[i, :2], self.goal[i], self.lanes)
         return self.planner.plan(request)
 

@@ -38,7 +38,7 @@ from adapters.navigation.contract import (
 )
 from adapters.navigation.fleet_traffic import FleetTraffic
 from adapters.navigation.goal_tracking import Drivers, GoalTracker
-from adapters.navigation.layers import robot_layers, static_costmap
+from adapters.navigation.layers import StaticLayers, padded, robot_layers, static_costmap
 from adapters.navigation.localization import Localization
 from adapters.navigation.planning import GlobalPlanning
 from adapters.navigation.recovery import Recovery, StallWatch
@@ -64,6 +64,7 @@ from cosim.core.recorder import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns, s_to_ns
 from cosim.scenario.model import Scenario
 from cosim.scenario.sections import LidarConfig, RobotsConfig
+from models.arrays import BoolArray
 from models.kinematics import FleetState
 from models.lidar import ScanGeometry
 from models.navigation.dwa import DwaParams
@@ -155,6 +156,8 @@ class NavigationAdapter:
         )
         self.recovery = Recovery(n, self.memory, self.limits, radius, self.rngs)
         self.stalls = StallWatch(self.pose)
+        self.off: BoolArray = np.zeros(n, dtype=bool)
+        """Robots whose pose is off the costmap (stopped until it is back)."""
         self.status_topics = [topic(n, "nav/status") for n in self.names]
         self.goals = GoalTracker(
             self.fleet,
@@ -177,11 +180,18 @@ class NavigationAdapter:
             bus.advertise(path, Path)
         if self.robots_layer is not None:
             self.robots_layer.advertise(run)
+        # plans keep out of gaps the controller will not enter (robots building their own
+        # maps plan on them as they come, unpadded)
+        padding = float(getattr(self.control, "footprint_padding_m", 0.0))
+        plan_static = padded(self.static, padding)
+        plan_layers = self.layers if self.mapping else StaticLayers.shared(plan_static, n)
         planner = planner_registry().get(cfg.planner)(PlannerContext(run, self.static))
         self.planning = GlobalPlanning(
             planner=planner,
             static=self.static,
             layers=self.layers,
+            plan_layers=plan_layers,
+            padding_m=padding,
             lanes=self.lanes,
             memory=self.memory,
             moving=self.moving,
@@ -266,8 +276,9 @@ class NavigationAdapter:
             self.traffic,
         )
         self.moving.remember(now_ns, moving.owner, moving.points)
-        # a robot without a recent pose does not know where it is: it stops
-        lost = self.measured.check(now_ns)
+        # a robot without a recent pose does not know where it is, nor one whose pose is off
+        # the map (a measured pose can be anything): it stops
+        lost = self.measured.check(now_ns) | self._off_map(run, now_ns)
         if self.manager is not None:
             self._control_places(run, now_ns, self.manager, points, start, moving, lost)
             return
@@ -299,6 +310,34 @@ class NavigationAdapter:
             ),
         )
         self._publish(run, v, w_cmd)
+
+    def _off_map(self, run: RunContext, now_ns: int) -> BoolArray:
+        """The robots whose pose lies off the costmap; leaving and coming back recorded.
+
+        A robot back on the costmap with a goal plans again at once (a plan asked for
+        while it was off found nothing).
+        """
+        static = self.static
+        x, y = self.pose[:, 0], self.pose[:, 1]
+        with np.errstate(invalid="ignore"):
+            ix = np.floor((x - static.origin_xy_m[0]) / static.resolution_m)
+            iy = np.floor((y - static.origin_xy_m[1]) / static.resolution_m)
+            on = (ix >= 0) & (ix < static.width) & (iy >= 0) & (iy < static.height)
+        off = ~on
+        for i in np.flatnonzero(off != self.off).tolist():
+            goal = self.goals.goal[i]
+            where = f"pose ({x[i]:.2f}, {y[i]:.2f}) m"
+            if off[i]:
+                grid = f"{static.width}x{static.height}"
+                detail = f"{where} outside the {grid} costmap: stopped"
+            else:
+                detail = f"{where}: back on the costmap"
+            event = "off_map" if off[i] else "on_map"
+            self.records.row(now_ns, i, event, goal[0], goal[1], detail=detail)
+            if not off[i] and self.goals.active[i] and self.manager is None:
+                self.planning.plan(run, i, now_ns, replan=True)
+        self.off = off
+        return off
 
     def _control_places(
         self,

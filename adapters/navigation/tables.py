@@ -22,7 +22,8 @@ NAVIGATION = TableSpec(
     {
         "t_s": "when (s)",
         "robot": "the robot",
-        "event": "goal, plan, replan, recovery, stuck, arrived, unreachable or cancelled",
+        "event": "goal, plan, replan, recovery, stuck, arrived, unreachable, cancelled, off_map "
+        "(the pose left the costmap: the robot stops) or on_map (it came back)",
         "goal_x_m": "the goal's x in map (m)",
         "goal_y_m": "the goal's y in map (m)",
         "path_length_m": "plans: the length of the path found (m); empty otherwise",
@@ -80,7 +81,7 @@ class NavRecords:
             detail=detail,
         )
         self.counts[event] = self.counts.get(event, 0) + 1
-        if event in ("stuck", "unreachable", "arrived"):
+        if event in ("stuck", "unreachable", "arrived", "off_map", "on_map"):
             text = f"goal ({goal_x_m:.2f}, {goal_y_m:.2f})" + (f": {detail}" if detail else "")
             self.recorder.event(t_ns, self.names[i], event, text)
 

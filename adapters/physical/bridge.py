@@ -15,6 +15,12 @@ rmw_cyclonedds maps them, see :mod:`adapters.ros2dds`):
 Stamps going out are ROS time (wall clock) of the simulated instant. DDS is polled at
 ``physical.poll_hz`` in the SENSING stage. Samples that fail to deserialize, carry no
 valid pose, or come from writers of another type on our topics are counted, never used.
+
+A physical robot whose pose has not been accepted for ``physical.pose_timeout_s`` (none
+since the start, or none since its last) ends the run: an event ``silent`` is recorded and
+:class:`SilentRobotError` names the robot, the pose source and where it was listened
+for. The run talks on the DDS domain it claimed (:mod:`adapters.ros2dds.domain`), given in
+the summary as ``physical_dds_domain``.
 """
 
 from __future__ import annotations
@@ -24,8 +30,10 @@ import math
 from collections.abc import Callable, Mapping
 from typing import Any, ClassVar
 
+from adapters.fleet.mirror import Mirrors
 from adapters.mocap.intake import PoseIntake
-from adapters.mocap.tracking import physical_robots
+from adapters.mocap.settings import MocapConfig
+from adapters.mocap.tracking import external_bodies, physical_robots
 from adapters.naming import topic
 from adapters.physical.settings import PhysicalConfig
 from adapters.ros2dds import types as dds
@@ -34,12 +42,21 @@ from adapters.ros2dds.qos import QosKind
 from adapters.ros2dds.session import DdsSession, dds_session
 from cosim.core.adapter import RunContext
 from cosim.core.bus import Envelope
+from cosim.core.errors import BridgeError
 from cosim.core.hosts import HostId
 from cosim.core.kernel import Stage
 from cosim.core.messages import LaserScan, Message, PoseStamped, Twist
 from cosim.core.messages.navigation import NavGoal
-from cosim.core.timebase import period_ns
+from cosim.core.recorder import Recorder
+from cosim.core.timebase import NS_PER_S, period_ns, s_to_ns
 from models.kinematics import FleetState
+
+WATCH_HZ = 4.0
+"""Rate at which the physical robots' poses are checked for silence (Hz)."""
+
+
+class SilentRobotError(BridgeError):
+    """A physical robot sent no usable pose for ``physical.pose_timeout_s``."""
 
 
 class PhysicalRobot:
@@ -55,6 +72,10 @@ class PhysicalRobot:
         self.scans_sent = 0
         self.commands_sent = 0
         self.invalid = 0
+        self.poses = 0
+        """Poses accepted so far (the twin's updates)."""
+        self.heard_ns: int | None = None
+        """Kernel time of the last accepted pose, None before the first."""
 
 
 class PhysicalAdapter:
@@ -79,6 +100,9 @@ class PhysicalAdapter:
         self.session: DdsSession | None = None
         self.foreign = 0
         self.malformed = 0
+        self.mirrors = run.service(Mirrors)
+        self.scenario = run.scenario
+        self.fleet_names = names
 
     def start(self, run: RunContext) -> None:
         """Join the DDS domain, open every robot's endpoints and start polling."""
@@ -107,6 +131,53 @@ class PhysicalAdapter:
                 )
         if self.intake is not None:
             run.kernel.every(period_ns(self.cfg.poll_hz), self._poll, stage=Stage.SENSING)
+        recorder = run.recorder
+        run.kernel.every(
+            period_ns(WATCH_HZ), lambda now: self._watch(now, recorder), stage=Stage.SENSING
+        )
+
+    def _watch(self, now_ns: int, recorder: Recorder) -> None:
+        """End the run when a physical robot has sent no pose for ``pose_timeout_s``.
+
+        Raises:
+            SilentRobotError: naming the robot, its pose source and where it was
+                listened for.
+        """
+        timeout_ns = s_to_ns(self.cfg.pose_timeout_s)
+        for robot in self.robots:
+            updates = int(self.mirrors.updates[robot.index])
+            if updates != robot.poses:
+                robot.poses, robot.heard_ns = updates, now_ns
+                continue
+            since = 0 if robot.heard_ns is None else robot.heard_ns
+            if now_ns - since < timeout_ns:
+                continue
+            when = (
+                "since the run started"
+                if robot.heard_ns is None
+                else f"since its last one at {robot.heard_ns / NS_PER_S:.1f} s"
+            )
+            text = (
+                f"physical robot {robot.name} sent no pose for {self.cfg.pose_timeout_s:g} s "
+                f"({when}): listened for {self._listened(robot)}"
+            )
+            recorder.event(now_ns, robot.name, "silent", text)
+            raise SilentRobotError(
+                f"{text}; expected the robot (or its stand-in, cosim run --standin) publishing "
+                f"there (physical.pose_timeout_s = {self.cfg.pose_timeout_s:g})"
+            )
+
+    def _listened(self, robot: PhysicalRobot) -> str:
+        """Where the poses of ``robot`` were expected: source, topic or body, domain."""
+        where = "" if self.session is None else f" on {self.session.where()}"
+        if self.cfg.pose == "odom":
+            return f"nav_msgs/Odometry on /{robot.name}/odom{where} (physical.pose = 'odom')"
+        mocap = self.scenario.section(MocapConfig)
+        body = dict(external_bodies(self.scenario, self.fleet_names)).get(robot.name, robot.name)
+        if mocap.source == "ros2":
+            return f"geometry_msgs/PoseStamped on {body}{where} (mocap.source = 'ros2')"
+        host = mocap.hostname or "no host"
+        return f"rigid body {body!r} of the {mocap.system} motion capture at {host!r}"
 
     def _on_scan(
         self, run: RunContext, robot: PhysicalRobot
@@ -188,6 +259,8 @@ class PhysicalAdapter:
         self.close()
         summary: dict[str, Any] = {
             "physical_robots": len(self.robots),
+            "physical_dds_domain": None if self.session is None else self.session.domain,
+            "physical_poses": sum(r.poses for r in self.robots),
             "physical_scans_sent": sum(r.scans_sent for r in self.robots),
             "physical_commands_sent": sum(r.commands_sent for r in self.robots),
             "physical_invalid_samples": sum(r.invalid for r in self.robots),

@@ -1,10 +1,15 @@
 """Stand-in robots for a run: one ``cosim standin`` process per physical robot.
 
 ``cosim run SCENARIO --standin`` plays the scenario's physical robots without hardware:
-each is a separate process on the scenario's DDS domain (and interface), started at the
+each is a separate process on the run's DDS domain (and interface), started at the
 robot's start pose with its drive limits and the motion capture's rate, latency and noise,
 so the run talks to it exactly as it would to a real robot. The processes are stopped
 (SIGTERM, then SIGKILL) when the run ends, however it ends.
+
+The run's domain is the scenario's ``physical.dds_domain``; with ``"auto"`` it is claimed
+here for the run (:func:`adapters.ros2dds.domain.claim_run_domain`) unless the caller
+claimed it first, and the run must then be given :attr:`Standins.scenario`, which names it.
+Each stand-in is told it by ``--domain`` (and ``ROS_DOMAIN_ID`` in its environment).
 """
 
 from __future__ import annotations
@@ -16,8 +21,10 @@ import threading
 import time
 
 from adapters.naming import robot_name
+from adapters.ros2dds.domain import RunDomain, claim_run_domain
 from adapters.world.warehouse import scenario_warehouse
 from cosim.core.errors import BridgeError, ConfigError
+from cosim.core.processes import die_with_parent
 from cosim.scenario.model import Scenario
 
 READY_TIMEOUT_S = 20.0
@@ -43,6 +50,11 @@ def standin_command(scenario: Scenario, robot: str, seed: int) -> list[str]:
         )
     x, y, yaw = poses[robot]
     mocap, robots, physical = scenario.mocap, scenario.robots, scenario.physical
+    if physical.dds_domain == "auto":
+        raise ConfigError(
+            f"{scenario.source}: [physical] dds_domain = 'auto': expected the run's claimed "
+            "domain (claim it with adapters.ros2dds.domain.claim_run_domain first)"
+        )
     command = [
         sys.executable, "-m", "cosim", "standin",
         "--name", robot,
@@ -66,6 +78,15 @@ class Standins:
 
     Args:
         scenario: the scenario; its ``physical.robots`` are played.
+
+    Attributes:
+        scenario: the scenario naming the DDS domain the stand-ins are on: run this one.
+        domain: the domain claimed here (``dds_domain = "auto"`` not claimed before), held
+            until :meth:`stop`; None when the scenario named its domain.
+
+    Raises:
+        ConfigError: the scenario has no physical robot.
+        BridgeError: no DDS domain can be claimed.
     """
 
     def __init__(self, scenario: Scenario) -> None:
@@ -74,6 +95,11 @@ class Standins:
                 f"{scenario.source}: --standin: expected physical.robots in the scenario "
                 "(there is no physical robot to stand in for)"
             )
+        self.domain: RunDomain | None = None
+        if scenario.physical.dds_domain == "auto":
+            self.domain = claim_run_domain(scenario)
+            assert self.domain is not None  # physical robots use DDS
+            scenario = self.domain.scenario
         self.scenario = scenario
         self.processes: dict[str, subprocess.Popen[str]] = {}
         self.output: dict[str, list[str]] = {}
@@ -84,7 +110,8 @@ class Standins:
         Raises:
             BridgeError: a stand-in exited or did not come up in time (its output quoted).
         """
-        env = {**os.environ, "PYTHONUNBUFFERED": "1"}
+        domain = str(self.scenario.physical.dds_domain)
+        env = {**os.environ, "PYTHONUNBUFFERED": "1", "ROS_DOMAIN_ID": domain}
         for k, robot in enumerate(self.scenario.physical.robots):
             command = standin_command(self.scenario, robot, self.scenario.seed + k)
             process = subprocess.Popen(
@@ -93,6 +120,7 @@ class Standins:
                 stderr=subprocess.STDOUT,
                 text=True,
                 env=env,
+                preexec_fn=die_with_parent,  # a run killed outright takes its stand-ins along
             )
             self.processes[robot] = process
             self.output[robot] = []
@@ -122,7 +150,7 @@ class Standins:
             raise BridgeError(f"stand-in for {robot} did not come up: {said}")
 
     def stop(self) -> None:
-        """Stop every stand-in (SIGTERM, then SIGKILL after 5 s)."""
+        """Stop every stand-in (SIGTERM, then SIGKILL after 5 s); give back the domain."""
         for process in self.processes.values():
             if process.poll() is None:
                 process.terminate()
@@ -132,3 +160,5 @@ class Standins:
             except subprocess.TimeoutExpired:
                 process.kill()
                 process.wait()
+        if self.domain is not None:
+            self.domain.close()

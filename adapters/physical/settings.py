@@ -23,9 +23,23 @@ class PhysicalConfig:
     """Where the section comes in a resolved scenario and in the adapters' order."""
 
     robots: tuple[str, ...] = param((), "names of the robots that are physical (robot_i)")
-    dds_domain: int = param(0, "DDS domain (ROS_DOMAIN_ID)", ge=0, le=232)
+    dds_domain: int | Literal["auto"] = param(
+        "auto",
+        "DDS domain (ROS_DOMAIN_ID) 0-232, or auto: on loopback, a domain 1-101 that no other "
+        "run or DDS participant of this machine uses, chosen per run (so that runs side by "
+        "side never hear each other's robots; the run says which)",
+        ge=0,
+        le=232,
+    )
     interface: str = param(
         "", "network interface or address for DDS; empty keeps DDS on loopback (127.0.0.1)"
+    )
+    pose_timeout_s: float = param(
+        10.0,
+        "a physical robot whose pose has not come for this long (from the start, or since "
+        "its last one) ends the run with an error naming it and where it was listened for (s)",
+        gt=0,
+        le=3600,
     )
     drive: Literal["cosim", "own"] = param(
         "cosim",
@@ -45,6 +59,13 @@ class PhysicalConfig:
         """Robot names must be unique."""
         if len(set(self.robots)) != len(self.robots):
             yield Problem("robots", list(self.robots), "each robot named once")
+        if self.dds_domain == "auto" and self.interface:
+            yield Problem(
+                "dds_domain",
+                self.dds_domain,
+                f"the robots' ROS_DOMAIN_ID (0-232) with interface = {self.interface!r}: a "
+                "robot on a network keeps its own domain",
+            )
 
     def adapters(self) -> tuple[str, ...]:
         """The adapters these settings ask for: the bridge, with physical robots."""

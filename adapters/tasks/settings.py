@@ -29,7 +29,11 @@ class TasksConfig:
     )
     dwell_s: float = param(2.0, "time a robot spends at a task to serve it (s)", ge=0)
     station_offset_m: float = param(
-        0.25, "pick stations: free space between the footprint and the shelf face (m)", gt=0
+        0.25,
+        "pick stations: free space between the footprint and the shelf face (m); a robot "
+        "serves a shelf within reach of it",
+        gt=0,
+        le=5.0,
     )
 
     def problems(self) -> Iterator[Problem]:

@@ -100,8 +100,10 @@ class TaskSourceAdapter:
         if not len(self.stations):
             raise ScenarioError(
                 f"{run.scenario.source}: world.shelf_count = "
-                f"{run.settings(WorldConfig).shelf_count}: "
-                "expected shelves with a reachable pick station (tasks are served at shelves)"
+                f"{run.settings(WorldConfig).shelf_count}, tasks.station_offset_m = "
+                f"{self.cfg.station_offset_m:g}: no pick station (a robot's spot that far from "
+                "a shelf face) is free and reachable by the fleet; expected shelves with "
+                "room in front of them (tasks are served at shelves)"
             )
         self.central = protocol_registry().get(self.assignment.protocol).central
         self.rng = run.rng.stream("tasks")

@@ -7,10 +7,14 @@ A flag's value is checked as it is parsed; a bad one is one line and exit status
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 from typing import NoReturn
 
 from adapters.physical.standin import add_arguments as add_standin_arguments
+from cosim.cli.hostname import host_argument
+from cosim.scenario.fields import key_bounds
+from cosim.scenario.sections import ScenarioSection
 
 EXIT_INPUT = 2
 
@@ -20,7 +24,14 @@ class Parser(argparse.ArgumentParser):
 
     def error(self, message: str) -> NoReturn:
         """Print one line naming the problem and exit 2."""
-        self.exit(EXIT_INPUT, f"{self.prog}: error: {message} (see `{self.prog} --help`)\n")
+        self.exit(
+            EXIT_INPUT, f"{self.prog}: error: {one_line(message)} (see `{self.prog} --help`)\n"
+        )
+
+
+def one_line(text: str) -> str:
+    """``text`` with its line breaks and other control characters escaped as ``repr`` does."""
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
 
 
 def _non_negative_int(text: str) -> int:
@@ -39,7 +50,7 @@ def _non_negative_float(text: str) -> float:
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
     if not value >= 0 or value == float("inf"):
-        raise argparse.ArgumentTypeError(f"{text} is not a finite number >= 0")
+        raise argparse.ArgumentTypeError(f"{value:g} is not a finite number >= 0")
     return value
 
 
@@ -67,8 +78,29 @@ def _positive_float(text: str) -> float:
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
     if not value > 0 or value == float("inf"):
-        raise argparse.ArgumentTypeError(f"{text} is not a finite number > 0")
+        raise argparse.ArgumentTypeError(f"{value:g} is not a finite number > 0")
     return value
+
+
+def _duration_s(text: str) -> float:
+    """``--duration-s``: within the bounds of ``scenario.duration_s`` (checked alike)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number of seconds") from None
+    bounds = key_bounds(ScenarioSection, "duration_s")
+    if not math.isfinite(value) or bounds.violation(value) is not None:
+        raise argparse.ArgumentTypeError(
+            f"{value:g} is not a duration {bounds.describe()} s (the bounds of scenario.duration_s)"
+        )
+    return value
+
+
+def _folder(text: str) -> Path:
+    """An output folder's name: not empty, and no NUL byte (no file system takes one)."""
+    if not text or "\0" in text:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a folder name")
+    return Path(text)
 
 
 def _between(text: str, low: float, high: float, what: str, unit: str = "") -> float:
@@ -77,7 +109,7 @@ def _between(text: str, low: float, high: float, what: str, unit: str = "") -> f
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
     if not low <= value <= high:  # NaN too
-        raise argparse.ArgumentTypeError(f"{text} is not {what} from {low:g} to {high:g}{unit}")
+        raise argparse.ArgumentTypeError(f"{value:g} is not {what} from {low:g} to {high:g}{unit}")
     return value
 
 
@@ -158,10 +190,19 @@ def build_parser() -> argparse.ArgumentParser:
         help="start a stand-in robot process (cosim standin) for every physical robot of "
         "the scenario, so mixed-reality scenarios run without hardware",
     )
-    run.add_argument("--out", type=Path, help="results folder (default: runs/NAME-seedN)")
+    run.add_argument("--out", type=_folder, help="results folder (default: runs/NAME-seedN)")
     run.add_argument("--seed", type=_non_negative_int, help="override scenario.seed")
-    run.add_argument("--duration-s", type=_positive_float, help="override scenario.duration_s (s)")
-    run.add_argument("--force", action="store_true", help="replace results in a non-empty --out")
+    run.add_argument(
+        "--duration-s",
+        type=_duration_s,
+        help="override scenario.duration_s (s; "
+        f"{key_bounds(ScenarioSection, 'duration_s').describe()}, as the key)",
+    )
+    run.add_argument(
+        "--force",
+        action="store_true",
+        help="replace the results of an earlier run in a non-empty --out (other files stay)",
+    )
     run.add_argument("--quiet", action="store_true", help="print nothing but errors")
     run.add_argument(
         "--bag",
@@ -186,6 +227,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     live.add_argument(
         "--live-host",
+        type=host_argument,
         default="127.0.0.1",
         help="address to bind (default 127.0.0.1: this machine only; 0.0.0.0: every interface)",
     )

@@ -75,6 +75,7 @@ def _tasks_phrase(s: dict[str, Any]) -> str | None:
 if TYPE_CHECKING:
     from cosim.recording.setup import RecordingSession
     from cosim.runner.execute import RunResult
+    from cosim.runner.stopping import RunStopped, StopRequest
 
 EXIT_OK = 0
 EXIT_BUG = 1
@@ -98,9 +99,25 @@ def _describe(scenario: Scenario) -> str:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
+    """``cosim run``; SIGINT, SIGTERM and SIGHUP stop it keeping what ran (128 + signal)."""
+    from cosim.runner.stopping import RunStopped, stop_on_signals
+
+    ran: list[Path] = []  # the results folder, once the run has written it
+    try:
+        with stop_on_signals() as stop:
+            return _run_and_report(args, stop, ran)
+    except RunStopped as stopped:
+        print(f"cosim: {_stopped_line(stopped, ran)}", file=sys.stderr)
+        return stopped.exit_status
+
+
+def _run_and_report(args: argparse.Namespace, stop: StopRequest, ran: list[Path]) -> int:
     from adapters.physical.launcher import Standins
+    from adapters.ros2dds.domain import claim_run_domain
+    from cosim.cli.hostname import check_live_host
     from cosim.recording.foxglove import LiveOptions
     from cosim.runner.execute import run
+    from cosim.runner.stopping import RunStopped
 
     if args.bag is not None:
         args.overrides.append(f"record.bag={args.bag}")
@@ -108,11 +125,19 @@ def _cmd_run(args: argparse.Namespace) -> int:
     if args.seed is not None:
         scenario = scenario.with_seed(args.seed)
     out = args.out or Path("runs") / f"{scenario.name}-seed{scenario.seed}"
+    if args.live:
+        check_live_host(args.live_host)
     live = (
         LiveOptions(args.live_host, args.live_port, args.live_rate, args.live_wait)
         if args.live
         else None
     )
+    # a run with robots on DDS takes a domain no other run on this machine hears
+    domain = claim_run_domain(scenario)
+    if domain is not None:
+        scenario = domain.scenario
+        if not args.quiet:
+            print(domain.claim.describe(), flush=True)
     progress = None if args.quiet else ProgressLine(label=f"{scenario.name}: ")
     standins = Standins(scenario) if args.standin else None
     try:
@@ -120,20 +145,29 @@ def _cmd_run(args: argparse.Namespace) -> int:
             started = standins.start()
             if not args.quiet:
                 print(f"stand-in robots: {', '.join(started)}", flush=True)
-        result = run(
-            scenario,
-            duration_s=args.duration_s,
-            out=out,
-            force=args.force,
-            progress=progress,
-            live=live,
-            on_ready=lambda session: _ready(session, quiet=args.quiet),
-        )
+        try:
+            result = run(
+                scenario,
+                duration_s=args.duration_s,
+                out=out,
+                force=args.force,
+                progress=progress,
+                live=live,
+                on_ready=lambda session: _ready(session, quiet=args.quiet),
+                stop=stop,
+            )
+        except RunStopped as stopped:
+            if stopped.result is not None and stopped.result.out is not None:
+                ran.append(out)
+            raise
     finally:
         if progress is not None:
             progress.close()
         if standins is not None:
             standins.stop()
+        if domain is not None:
+            domain.close()
+    ran.append(out)
     figures = []
     if args.figures or args.gif:
         from cosim.plotting.command import plot_run
@@ -142,6 +176,22 @@ def _cmd_run(args: argparse.Namespace) -> int:
     if not args.quiet:
         _print_run(result, out, figures)
     return EXIT_OK
+
+
+def _stopped_line(stopped: RunStopped, ran: list[Path]) -> str:
+    """What a stopped run kept, in one line."""
+    name = str(stopped)
+    result = stopped.result
+    if not ran:
+        return f"{name} before the run's results were written"
+    out = ran[0]
+    if result is None or result.stopped is None:
+        return f"{name}; the run had finished: its results are complete in {out}/"
+    s = result.summary
+    return (
+        f"{name} at {s['sim_time_s']:g} s of {s['planned_duration_s']:g} s simulated; "
+        f'the results so far are in {out}/ (summary.json says "stopped")'
+    )
 
 
 def _ready(session: RecordingSession, *, quiet: bool) -> None:

@@ -7,9 +7,22 @@ one line and exit with status 2. Anything else escaping the run is a bug (status
 
 from __future__ import annotations
 
+from typing import Any
+
 
 class CosimError(Exception):
-    """Root of every error that cosim raises on purpose."""
+    """Root of every error that cosim raises on purpose.
+
+    Attributes:
+        kept: what a run kept before this error ended it (its ``RunResult``: the tables and
+            a summary of the simulated time reached), or None.
+    """
+
+    kept: Any = None
+
+    def say_kept(self, where: str) -> None:
+        """Add where the results of the run so far are to the one-line message."""
+        self.args = (f"{self}; {where}",)
 
 
 class ConfigError(CosimError):
@@ -37,4 +50,7 @@ class WorkerError(CosimError):
 
 
 class BridgeError(CosimError):
-    """An external system (DDS, SUMO, motion capture) cannot be reached or misbehaves."""
+    """An external system (DDS, SUMO, motion capture) cannot be reached or misbehaves.
+
+    Raised while the kernel runs, it ends the run keeping what ran (:attr:`kept`).
+    """

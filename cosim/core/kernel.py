@@ -87,6 +87,20 @@ class Lateness:
     late_ns: array[int] = field(default_factory=lambda: array("q"))
     events: array[int] = field(default_factory=lambda: array("q"))
 
+    def close_batch(self, batch_events: int) -> None:
+        """Close the batch under way, the columns of one length however the run ended.
+
+        A stop (Ctrl-C, an error) may land between the appends of a batch's columns.
+
+        Args:
+            batch_events: events processed in the batch under way.
+        """
+        if len(self.events) < len(self.t_ns):
+            self.events.append(batch_events)
+        rows = min(len(self.t_ns), len(self.late_ns), len(self.events))
+        for column in (self.t_ns, self.late_ns, self.events):
+            del column[rows:]
+
 
 ProgressFn = Callable[[int, int], None]
 """Called during :meth:`Kernel.run` with (sim time in ns, events processed so far)."""
@@ -256,22 +270,24 @@ class Kernel:
         batch_t = -1
         batch_events = 0
         next_report = monotonic() + progress_interval_s
-        while (t := peek()) < until_ns:
-            if t != batch_t:
-                if batch_t >= 0:
-                    record.events.append(batch_events)
-                due = env.real_start + (t - env.env_start) * factor
-                record.t_ns.append(int(t))
-                record.late_ns.append(max(0, round((monotonic() - due) * 1e9)))
-                batch_t, batch_events = int(t), 0
-            step()
-            processed += 1
-            batch_events += 1
-            if progress is not None and monotonic() >= next_report:
-                progress(self.now_ns, processed)
-                next_report = monotonic() + progress_interval_s
-        if batch_t >= 0:
-            record.events.append(batch_events)
+        try:
+            while (t := peek()) < until_ns:
+                if t != batch_t:
+                    if batch_t >= 0:
+                        record.events.append(batch_events)
+                    due = env.real_start + (t - env.env_start) * factor
+                    late_ns = max(0, round((monotonic() - due) * 1e9))
+                    record.t_ns.append(int(t))
+                    record.late_ns.append(late_ns)
+                    batch_t, batch_events = int(t), 0
+                step()
+                processed += 1
+                batch_events += 1
+                if progress is not None and monotonic() >= next_report:
+                    progress(self.now_ns, processed)
+                    next_report = monotonic() + progress_interval_s
+        finally:  # a stop (Ctrl-C, an error) may land anywhere: keep the columns aligned
+            record.close_batch(batch_events)
         if until_ns > self.now_ns:
             env.run(until=until_ns)
         self.events_processed += processed

@@ -303,6 +303,11 @@ class AdapterRegistry(Registry[Any]):
                 raise RegistryError(f"adapter requirement cycle: {cycle}")
             visiting.append(name)
             for required in self.get(name).requires:
+                if required not in self._entries:
+                    raise RegistryError(
+                        f"adapter {name!r} ({self.target(name)}) requires "
+                        f"{self.unknown(required)!s}"
+                    )
                 visit(required)
             visiting.pop()
             ordered.append(name)

@@ -11,6 +11,7 @@ commits every :data:`COMMIT_EVERY` messages for the same reason.
 
 from __future__ import annotations
 
+import contextlib
 import struct
 import sys
 from collections.abc import Mapping, Sequence
@@ -201,8 +202,18 @@ class BagSink:
             try:
                 writer.close()
             except (WriterError, OSError) as error:
+                _release(writer.storage)  # a full disk: do not hold its file open too
                 raise ExportError(f"{self.path}: cannot finish the bag ({error})") from None
 
     def files(self) -> list[Path]:
         """The bag's files (storage and ``metadata.yaml``)."""
         return sorted(p for p in self.path.iterdir() if p.is_file())
+
+
+def _release(storage: Any) -> None:
+    """Close the file (MCAP) or database (sqlite3) of a storage that failed to finish."""
+    for name in ("bio", "conn"):
+        handle = getattr(storage, name, None)
+        if handle is not None:
+            with contextlib.suppress(Exception):
+                handle.close()

@@ -103,6 +103,12 @@ class LiveSink:
             )
         except RuntimeError as error:
             reason = str(error).removeprefix("FoxgloveError: ")
+            if "in use" not in reason.lower():  # not the port: the address (or the system)
+                raise BridgeError(
+                    f"--live-host {host} --live-port {port}: cannot serve the live view there "
+                    f"({reason}); expected an address of this machine (127.0.0.1, 0.0.0.0) "
+                    "and a free port"
+                ) from None
             raise BridgeError(
                 f"--live-port {port}: cannot serve the live view on {host}:{port} ({reason}); "
                 "expected a free port (another `cosim run --live` or a Foxglove bridge may "

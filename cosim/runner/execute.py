@@ -2,11 +2,10 @@
 
 from __future__ import annotations
 
-import json
+import contextlib
 import platform
-import shutil
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from importlib.metadata import version
 from pathlib import Path
@@ -15,9 +14,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from adapters.world.files import write_map
 from cosim.core.adapter import AdapterType
-from cosim.core.errors import ExportError, RegistryError
+from cosim.core.errors import BridgeError, CosimError, RegistryError
 from cosim.core.kernel import Lateness
 from cosim.core.recorder import MapArtifact, Recorder, TableSpec, merge_counts
 from cosim.core.registry import AdapterRegistry
@@ -25,15 +23,15 @@ from cosim.core.timebase import NS_PER_S, s_to_ns
 from cosim.recording.foxglove import LiveOptions
 from cosim.recording.setup import RecordingPlan, RecordingSession
 from cosim.runner.assembly import Assembly, assemble
-from cosim.scenario.loader import dump_scenario
+from cosim.runner.outfolder import prepare_out, write_run
+from cosim.runner.stopping import CHECK_EVERY_S, RunStopped, StopRequest, signal_name
 from cosim.scenario.model import Scenario
-from models.occupancy import OccupancyGrid
 
 ProgressFn = Callable[[float, float, float], None]
 """Progress callback: (sim time s, duration s, wall time s)."""
 
-OUTPUTS = ("summary.json", "scenario.toml", "tables", "figures", "bag", "maps", "sumo")
-"""What a run writes into its folder (``--force`` removes exactly these)."""
+PROGRESS_EVERY_S = 0.5
+"""Wall-clock seconds between progress calls."""
 
 
 @dataclass
@@ -49,6 +47,10 @@ class RunResult:
         recorded: messages recorded per topic (bag or live view).
         maps: final occupancy maps by name (written as ``maps/NAME.yaml`` + ``.pgm``).
         files: other files for the run folder by relative path (SUMO's ``sumo/...``).
+        stopped: the signal that stopped the run before its duration, or None (the
+            summary then says ``"stopped"`` and the simulated time reached).
+        failure: the error of an external system that ended the run early (a robot or a
+            motion-capture server gone silent), or None; the summary then says ``"failed"``.
     """
 
     scenario: Scenario
@@ -60,6 +62,8 @@ class RunResult:
     recorded: dict[str, int] = field(default_factory=dict, repr=False)
     maps: dict[str, MapArtifact] = field(default_factory=dict, repr=False)
     files: dict[str, bytes] = field(default_factory=dict, repr=False)
+    stopped: int | None = None
+    failure: CosimError | None = field(default=None, repr=False)
 
     def deterministic_tables(self) -> dict[str, pd.DataFrame]:
         """The tables without their wall-clock columns: equal for equal scenario and seed."""
@@ -85,6 +89,7 @@ def execute(
     live: LiveOptions | None = None,
     on_ready: Callable[[RecordingSession], None] | None = None,
     adapters: Sequence[str | AdapterType] = (),
+    stop: StopRequest | None = None,
 ) -> RunResult:
     """Run a scenario to its duration and return its result.
 
@@ -105,35 +110,52 @@ def execute(
             (the command line prints the live view's address there).
         adapters: more adapters to run: registered names, or adapter classes (used for
             this run as if registered under their ``name``).
+        stop: a stop request (:func:`cosim.runner.stopping.stop_on_signals`): while the
+            kernel runs, a stop asked for ends the run at an event boundary and the result
+            covers the simulated time reached (``stopped``); before, it raises
+            :class:`~cosim.runner.stopping.RunStopped` at once.
+
+    Raises:
+        BridgeError: an external system failed while the kernel ran (a physical robot or a
+            motion-capture server gone silent); the bag is finished and the error's
+            ``kept`` holds the result of the simulated time reached.
     """
-    plan = RecordingPlan.for_run(scenario, out, live)
-    registry, extra = with_adapters(registry or AdapterRegistry.from_entry_points(), adapters)
-    assembly = assemble(
-        scenario,
-        names=names,
-        registry=registry,
-        extra=extra,
-        realtime=live is not None,
-        speed=live.rate if live is not None else 1.0,
-        recording=plan.active,
-    )
-    run = assembly.run
-    topics = RecordingSession.topics_of(scenario, run.bus) if plan.active else {}
-    session = RecordingSession(plan, topics, run.bus)
+    with _immediate(stop):
+        plan = RecordingPlan.for_run(scenario, out, live)
+        registry, extra = with_adapters(registry or AdapterRegistry.from_entry_points(), adapters)
+        assembly = assemble(
+            scenario,
+            names=names,
+            registry=registry,
+            extra=extra,
+            realtime=live is not None,
+            speed=live.rate if live is not None else 1.0,
+            recording=plan.active,
+        )
+        run = assembly.run
+        topics = RecordingSession.topics_of(scenario, run.bus) if plan.active else {}
+        session = RecordingSession(plan, topics, run.bus)
     folder = Path(out) if out is not None else None
-    prepare = None if folder is None else lambda: prepare_out(folder, force=force)
-    if plan.active:
-        session.open(before_bag=prepare)
-    elif prepare is not None:
-        prepare()
+    bag = plan.bag is not None
+    prepare = None if folder is None else lambda: prepare_out(folder, force=force, bag=bag)
     try:
-        if on_ready is not None:
-            on_ready(session)
-        result = _run_assembled(scenario, assembly, progress)
+        with _immediate(stop):
+            if plan.active:
+                session.open(before_bag=prepare)
+            elif prepare is not None:
+                prepare()
+            if on_ready is not None:
+                on_ready(session)
+        with _deferred(stop):
+            result = _run_assembled(scenario, assembly, progress, stop)
     finally:
-        session.close()
+        with _deferred(stop):  # the bag is finished (metadata.yaml) whatever stopped the run
+            session.close()
     result.bag = plan.bag
     result.recorded = session.counts()
+    if result.failure is not None:
+        result.failure.kept = result
+        raise result.failure
     return result
 
 
@@ -144,6 +166,10 @@ def with_adapters(
     names = []
     for adapter in adapters:
         if isinstance(adapter, str):
+            if adapter not in registry.names():
+                raise RegistryError(
+                    f"cosim.run(adapters=[..., {adapter!r}, ...]): {registry.unknown(adapter)}"
+                )
             names.append(adapter)
             continue
         name = getattr(adapter, "name", None)
@@ -154,8 +180,27 @@ def with_adapters(
     return registry, names
 
 
+@contextlib.contextmanager
+def _immediate(stop: StopRequest | None) -> Iterator[None]:
+    with stop.immediate() if stop is not None else contextlib.nullcontext():
+        yield
+
+
+@contextlib.contextmanager
+def _deferred(stop: StopRequest | None) -> Iterator[None]:
+    with stop.deferred() if stop is not None else contextlib.nullcontext():
+        yield
+
+
+class _HaltError(Exception):
+    """Raised by the progress check, between two events, to end a run asked to stop."""
+
+
 def _run_assembled(
-    scenario: Scenario, assembly: Assembly, progress: ProgressFn | None
+    scenario: Scenario,
+    assembly: Assembly,
+    progress: ProgressFn | None,
+    stop: StopRequest | None = None,
 ) -> RunResult:
     run = assembly.run
     duration_s = scenario.scenario.duration_s
@@ -163,19 +208,39 @@ def _run_assembled(
     wall_start = time.perf_counter()
     for _name, adapter in assembly.adapters:
         adapter.start(run)
+    done = [0]  # events processed when the last check ran
+    next_progress = [0.0]
 
-    def report(now_ns: int, _events: int) -> None:
-        if progress is not None:
-            progress(now_ns / NS_PER_S, duration_s, time.perf_counter() - wall_start)
+    def report(now_ns: int, events: int) -> None:
+        done[0] = events
+        wall = time.perf_counter() - wall_start
+        if progress is not None and (wall >= next_progress[0] or now_ns >= until_ns):
+            progress(now_ns / NS_PER_S, duration_s, wall)
+            next_progress[0] = wall + PROGRESS_EVERY_S
+        if stop is not None and stop.requested and now_ns < until_ns:
+            raise _HaltError
 
+    halted = stop is not None and stop.requested
+    failure: BridgeError | None = None
     try:
-        events = run.kernel.run(until_ns, progress=report if progress else None)
+        events = 0
+        if not halted:
+            events = run.kernel.run(
+                until_ns,
+                progress=report if progress is not None or stop is not None else None,
+                progress_interval_s=CHECK_EVERY_S if stop is not None else PROGRESS_EVERY_S,
+            )
+    except _HaltError:
+        halted, events = True, done[0]
+    except BridgeError as error:  # the real world failed (a silent robot, a mocap server)
+        halted, events, failure = True, done[0], error
     finally:
         for _name, adapter in assembly.adapters:
             close = getattr(adapter, "close", None)
             if close is not None:
                 close()
     wall_s = time.perf_counter() - wall_start
+    reached_s = run.kernel.now_ns / NS_PER_S if halted else duration_s
     counts = run.recorder.counts
     sent = sum(counts.values())
     summary: dict[str, Any] = {
@@ -184,9 +249,9 @@ def _run_assembled(
         "seed": scenario.seed,
         "version": cosim_version(),
         "python": platform.python_version(),
-        "sim_time_s": duration_s,
+        "sim_time_s": reached_s,
         "wall_time_s": round(wall_s, 4),
-        "real_time_factor": round(duration_s / wall_s, 2) if wall_s > 0 else None,
+        "real_time_factor": round(reached_s / wall_s, 2) if wall_s > 0 else None,
         "events": events,
         "messages_sent": sent,
         "messages_delivered": counts["delivered"],
@@ -194,6 +259,12 @@ def _run_assembled(
         "network_messages": run.recorder.network_messages,
         "network_bytes": run.recorder.network_bytes,
     }
+    stopped = stop.signum if halted and stop is not None else None
+    if stopped is not None:
+        # a run that did not reach its duration says so before anything else
+        summary = {"stopped": signal_name(stopped), "planned_duration_s": duration_s, **summary}
+    if failure is not None:
+        summary = {"failed": str(failure), "planned_duration_s": duration_s, **summary}
     if run.kernel.lateness is not None:
         summary.update(record_lateness(run.kernel.lateness, run.recorder))
     for name, adapter in assembly.adapters:
@@ -208,6 +279,8 @@ def _run_assembled(
         volatile=run.recorder.volatile,
         maps=dict(run.recorder.maps),
         files=dict(run.recorder.files),
+        stopped=stopped,
+        failure=failure,
     )
 
 
@@ -227,14 +300,16 @@ def record_lateness(lateness: Lateness, recorder: Recorder) -> dict[str, Any]:
     """Write ``tables/realtime`` (one row per event batch) and return the summary keys.
 
     Columns: t_s (the batch's simulated instant), lateness_ms (wall-clock ms past the
-    instant it was due), events (in the batch). Wall-clock figures: volatile.
+    instant it was due), events (in the batch). Wall-clock figures: volatile. A run stopped
+    in the middle of a batch leaves that batch out (its events were not all counted).
     """
-    late_ms = np.frombuffer(lateness.late_ns, dtype=np.int64) / 1e6
+    batches = min(len(lateness.t_ns), len(lateness.late_ns), len(lateness.events))
+    late_ms = np.frombuffer(lateness.late_ns, dtype=np.int64)[:batches] / 1e6
     table = recorder.table(REALTIME)
     table.extend(
-        t_s=np.frombuffer(lateness.t_ns, dtype=np.int64) / NS_PER_S,
+        t_s=np.frombuffer(lateness.t_ns, dtype=np.int64)[:batches] / NS_PER_S,
         lateness_ms=late_ms,
-        events=np.frombuffer(lateness.events, dtype=np.int64),
+        events=np.frombuffer(lateness.events, dtype=np.int64)[:batches],
     )
     if late_ms.size == 0:
         return {"max_lateness_ms": None, "p99_lateness_ms": None, "late_batches": 0}
@@ -243,59 +318,6 @@ def record_lateness(lateness: Lateness, recorder: Recorder) -> dict[str, Any]:
         "p99_lateness_ms": round(float(np.percentile(late_ms, 99)), 3),
         "late_batches": int((late_ms > 1.0).sum()),
     }
-
-
-def prepare_out(out: Path, *, force: bool) -> None:
-    """Make sure ``out`` can take a run's results.
-
-    Raises:
-        ExportError: if ``out`` is a file, or a non-empty folder and ``force`` is false.
-    """
-    if out.exists() and not out.is_dir():
-        raise ExportError(f"{out}: exists and is not a folder")
-    if out.is_dir() and any(out.iterdir()):
-        if not force:
-            raise ExportError(f"{out}: folder is not empty; not overwriting (use --force)")
-        for name in OUTPUTS:
-            target = out / name
-            if target.is_dir():
-                shutil.rmtree(target)
-            elif target.exists():
-                target.unlink()
-
-
-def write_run(result: RunResult, out: Path, *, tables: bool = True) -> None:
-    """Write a run's folder atomically: into ``out.partial`` first, then renamed in place."""
-    out = Path(out)
-    partial = out.with_name(out.name + ".partial")
-    if partial.exists():
-        shutil.rmtree(partial)
-    try:
-        partial.mkdir(parents=True)
-        (partial / "scenario.toml").write_text(dump_scenario(result.scenario), encoding="utf-8")
-        if tables:
-            (partial / "tables").mkdir()
-            for name, frame in result.tables.items():
-                frame.to_parquet(partial / "tables" / f"{name}.parquet", index=False)
-        for name, grid in result.maps.items():
-            write_map(
-                OccupancyGrid(grid.resolution_m, grid.origin_xy_m, grid.data),
-                partial / "maps" / f"{name}.yaml",
-            )
-        for relative, data in result.files.items():
-            target = partial / relative
-            target.parent.mkdir(parents=True, exist_ok=True)
-            target.write_bytes(data)
-        (partial / "summary.json").write_text(
-            json.dumps(result.summary, indent=2, allow_nan=False) + "\n", encoding="utf-8"
-        )
-        out.mkdir(parents=True, exist_ok=True)
-        for entry in sorted(partial.iterdir()):
-            entry.rename(out / entry.name)
-        partial.rmdir()
-    except OSError as error:
-        raise ExportError(f"{out}: cannot write results ({error})") from error
-    result.out = out
 
 
 def run(
@@ -309,6 +331,7 @@ def run(
     live: LiveOptions | None = None,
     on_ready: Callable[[RecordingSession], None] | None = None,
     adapters: Sequence[str | AdapterType] = (),
+    stop: StopRequest | None = None,
 ) -> RunResult:
     """Run a scenario; optionally write its folder.
 
@@ -331,24 +354,51 @@ def run(
         adapters: more adapters to run: registered names, or adapter classes (a class is
             used for this run as if registered under its ``name``; the resolved
             ``scenario.toml`` cannot name it, so ``cosim run`` of that file runs without it).
+        stop: a stop request (:func:`cosim.runner.stopping.stop_on_signals`): a run asked
+            to stop ends at an event boundary, and what ran is kept (the bag finished, the
+            tables and a summary marked ``"stopped"`` written) before
+            :class:`~cosim.runner.stopping.RunStopped` is raised with the result.
 
     Returns:
         The run's summary and tables.
+
+    Raises:
+        RunStopped: the run was asked to stop (``stop``).
+        BridgeError: an external system failed mid-run; with ``out``, what ran is written
+            there first and the message says where.
     """
     if seed is not None:
         scenario = scenario.with_seed(seed)
     if duration_s is not None:
         scenario = scenario.with_duration(duration_s)
     folder = Path(out) if out is not None else None
-    result = execute(
-        scenario,
-        progress=progress,
-        out=folder,
-        force=force,
-        live=live,
-        on_ready=on_ready,
-        adapters=adapters,
-    )
-    if folder is not None:
-        write_run(result, folder, tables=scenario.record.tables)
+    with _deferred(stop):
+        try:
+            result = execute(
+                scenario,
+                progress=progress,
+                out=folder,
+                force=force,
+                live=live,
+                on_ready=on_ready,
+                adapters=adapters,
+                stop=stop,
+            )
+        except BridgeError as error:
+            if error.kept is None or folder is None:
+                raise
+            write_run(error.kept, folder, tables=scenario.record.tables)
+            reached = error.kept.summary["sim_time_s"]
+            error.say_kept(
+                f"the results of the {reached:g} s simulated are in {folder}/ "
+                '(summary.json says "failed")'
+            )
+            raise
+        if folder is not None:
+            write_run(result, folder, tables=scenario.record.tables)
+    if stop is not None and stop.signum is not None:
+        raise RunStopped(stop.signum, result)
     return result
+
+
+__all__ = ["RunResult", "RunStopped", "execute", "prepare_out", "run", "write_run"]

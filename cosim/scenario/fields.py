@@ -263,6 +263,15 @@ def implicit_bounds(key: str, bounds: Bounds) -> Bounds:
     return bounds
 
 
+def key_bounds(cls: type[Any], key: str) -> Bounds:
+    """The bounds a section's key is checked against when loaded (declared and implicit).
+
+    A command-line flag that overrides a key (``cosim run --duration-s``) checks the same.
+    """
+    found = {f.name: f for f in dataclasses.fields(cls)}[key]
+    return implicit_bounds(key, found.metadata.get("bounds", Bounds()))
+
+
 def field_names(cls: type[Any]) -> list[str]:
     """Names of a section's fields in declaration order."""
     return [f.name for f in dataclasses.fields(cls)]
@@ -376,6 +385,7 @@ __all__ = [
     "docs",
     "field_names",
     "format_problem",
+    "key_bounds",
     "model_problem",
     "param",
     "suggest",

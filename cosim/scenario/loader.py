@@ -14,7 +14,14 @@ from typing import Any
 from cosim.core.errors import ConfigError, RegistryError
 from cosim.scenario.fields import build, show_name, show_value, suggest
 from cosim.scenario.model import Scenario, section_classes, section_registry
-from cosim.scenario.tomlfile import parse_toml, read_toml_file
+from cosim.scenario.tomlfile import (
+    MAX_DEPTH,
+    deeper_than,
+    parse_toml,
+    read_toml_file,
+    refuse_long_keys,
+    too_deep,
+)
 
 PRESET_PACKAGE = "cosim.presets"
 
@@ -67,17 +74,25 @@ def parse_override(text: str) -> tuple[str, Any]:
     schema then checks its type like any other value.
 
     Raises:
-        ConfigError: if ``text`` has no ``=`` or no ``section.key`` before it.
+        ConfigError: if ``text`` has no ``=`` or no ``section.key`` before it, or its
+            value nests deeper than a file may
+            (:data:`~cosim.scenario.tomlfile.MAX_DEPTH`).
     """
     key, sep, raw = text.partition("=")
     key = key.strip()
     if not sep or key.count(".") != 1 or not all(key.split(".")):
         raise ConfigError(f"--set {text}: expected section.key=value, e.g. lidar.rate_hz=20")
     raw = raw.strip()
+    origin = f"--set {key}"
+    refuse_long_keys(raw, origin)
     try:
         value = tomllib.loads(f"v = {raw}")["v"]
     except tomllib.TOMLDecodeError:
         value = raw
+    except RecursionError:  # arrays in arrays, a thousand deep
+        raise ConfigError(too_deep(origin)) from None
+    if deeper_than(value, MAX_DEPTH - 2):  # the value sits two levels down: [section] key
+        raise ConfigError(too_deep(origin))
     return key, value
 
 

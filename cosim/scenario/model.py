@@ -11,13 +11,15 @@ it by name (untyped).
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Collection, Iterator, Mapping
 from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 from typing import Any, TypeVar
 
-from cosim.core.errors import RegistryError
+from cosim.core.errors import ConfigError, RegistryError
 from cosim.core.registry import Registry
+from cosim.scenario.fields import key_bounds
 from cosim.scenario.sections import (
     LidarConfig,
     OdometryConfig,
@@ -176,7 +178,18 @@ class Scenario:
         return self.with_section("scenario", replace(self.scenario, seed=seed))
 
     def with_duration(self, duration_s: float) -> Scenario:
-        """Return a copy with another duration (s)."""
+        """Return a copy with another duration (s), within the bounds of ``scenario.duration_s``.
+
+        Raises:
+            ConfigError: a duration that is not a finite number within those bounds.
+        """
+        bounds = key_bounds(ScenarioSection, "duration_s")
+        number = isinstance(duration_s, int | float) and not isinstance(duration_s, bool)
+        if not number or not math.isfinite(duration_s) or bounds.violation(duration_s):
+            raise ConfigError(
+                f"duration_s = {duration_s!r}: expected a number {bounds.describe()} (s; the "
+                "bounds of scenario.duration_s)"
+            )
         return self.with_section("scenario", replace(self.scenario, duration_s=duration_s))
 
 

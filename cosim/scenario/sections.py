@@ -12,6 +12,7 @@ typical indoor setting, below the hardware's 2.0 m/s.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import ClassVar, Literal
@@ -19,6 +20,10 @@ from typing import ClassVar, Literal
 from cosim.scenario.fields import Problem, param
 
 Layout = Literal["random", "all_rows", "two_corridors"]
+FOLDER_NAME = re.compile(r"[\w.+-]+")
+"""A scenario name: one folder name (letters, digits, ``_``, ``-``, ``.``, ``+``)."""
+NAME_CHARS = 100
+"""Longest scenario name: it names a folder (``runs/NAME-seedN``), at most 255 bytes."""
 Placement = Literal["dock", "random", "explicit"]
 
 
@@ -35,6 +40,21 @@ class ScenarioSection:
     adapters: tuple[str, ...] = param(
         (), "extra adapters to start, by registered name (`cosim plugins`)", registry="adapter"
     )
+
+    def problems(self) -> Iterator[Problem]:
+        """The name is one folder name: runs are written to ``runs/NAME-seedN``."""
+        name = self.name
+        if (
+            not FOLDER_NAME.fullmatch(name)
+            or name in (".", "..")
+            or len(name.encode("utf-8")) > NAME_CHARS
+        ):
+            yield Problem(
+                "name",
+                name,
+                f"one folder name of at most {NAME_CHARS} bytes: letters, digits, '_', '-', "
+                "'.' and '+' (no '/', not '.' or '..')",
+            )
 
 
 @dataclass(frozen=True)

@@ -110,6 +110,8 @@ KEYS = [
     "mocap.file",
     "mocap.system",
     "mocap.topic_pattern",
+    "mocap.connect_timeout_s",
+    "mocap.hostname",
     "physical.robots",
     "physical.dds_domain",
     "physical.interface",

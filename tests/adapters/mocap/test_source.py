@@ -126,8 +126,10 @@ def test_a_replayed_csv_track_moves_its_robot_along_the_recording(tmp_path: Path
     assert result.summary["mocap_poses"] == 60
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not NAV2.exists(), reason=f"{NAV2} absent (the shared data folder)")
-def test_a_robot_replays_the_odometry_of_a_bag_written_by_rosbag2():
+def test_odometry_of_a_rosbag2_bag_recorded_outside_the_room_is_rejected_and_the_twin_held():
+    # the TurtleBot's odometry starts at (-2.8, 1.1) m, outside the 12 m x 12 m room
     s = scenario(
         **{
             "scenario.duration_s": 20.0,
@@ -139,16 +141,25 @@ def test_a_robot_replays_the_odometry_of_a_bag_written_by_rosbag2():
         }
     )
     track = read_pose_track(NAV2, "/odom")
+    replayed = int((track.relative() <= 20_000_000_000).sum())
     result = execute(s)
-    poses = result.tables["poses"]
-    twin = poses[poses.robot == "robot_2"]
-    t0 = int(track.t_ns[0])
-    for t_s, x, y in zip(twin.t_s, twin.x_m, twin.y_m, strict=True):
-        k = track.at(t0 + round(t_s * 1e9) - 50_000_000)  # applied at the last 20 Hz tick
-        if k < 0:
-            continue
-        assert abs(x - track.x_m[k]) < 0.05 and abs(y - track.y_m[k]) < 0.05
-    assert result.summary["mocap_rejected_jumps"] == 0
+    mocap = result.tables["mocap"]
+    assert list(mocap.event) == ["off_map", "on_map", "off_map"]  # one row each way
+    assert mocap.detail.iloc[0] == (
+        "pose (-2.80, 1.10) m outside the world [-0.2, 12.2] x [-0.2, 12.2] m: rejected, the "
+        "robot holds its last pose"
+    )
+    events = result.tables["events"]
+    kinds = [k for k in events[events.source == "robot_2"].kind if k.startswith("pose_")]
+    assert kinds == ["pose_off_map", "pose_on_map", "pose_off_map"]
+    twin = result.tables["poses"].query("robot == 'robot_2'")
+    back_s = mocap.t_s.iloc[1]
+    before = twin[twin.t_s < back_s]
+    assert (before.x_m.nunique(), before.y_m.nunique()) == (1, 1)  # held where it started
+    assert twin.x_m.between(-0.2, 12.2).all() and twin.y_m.between(-0.2, 12.2).all()
+    summary = result.summary
+    assert summary["mocap_rejected_off_map"] + summary["mocap_poses"] == replayed
+    assert 0 < summary["mocap_poses"] < replayed / 4
 
 
 def test_a_bag_without_the_named_topic_is_refused_before_the_run(tmp_path: Path):

@@ -1,23 +1,27 @@
 """A physical robot in a run, over DDS: a real second process plays it (cosim standin)."""
 
+import json
 import math
-import random
 import threading
 import time
 from dataclasses import dataclass
 
+import pandas as pd
 import pytest
 from cyclonedds.idl import IdlStruct
 from cyclonedds.idl.annotations import final
 
 import cosim
-from adapters.physical.launcher import Standins
+from adapters.physical.bridge import SilentRobotError
+from adapters.physical.launcher import Standins, standin_command
+from adapters.ros2dds.domain import claim_run_domain
 from adapters.ros2dds.participant import RosParticipant
 from adapters.ros2dds.qos import QosKind
 from adapters.ros2dds.types import Header, Odometry, Point, Pose, PoseWithCovariance, Quaternion
 from adapters.ros2dds.types import stamp as ros_stamp
 from cosim.core.errors import ConfigError
 from cosim.runner.execute import execute
+from tests.conftest import cosim_main
 
 pytestmark = pytest.mark.slow
 
@@ -28,18 +32,12 @@ class String(IdlStruct, typename="std_msgs::msg::dds_::String_"):
     data: str = ""
 
 
-def domain() -> int:
-    """A domain of its own, so that concurrent test runs on this machine never meet."""
-    return random.SystemRandom().randint(1, 200)
-
-
 @pytest.mark.slow
 def test_a_standin_robot_follows_the_navigation_and_stops_when_its_poses_stop():
-    s = cosim.load_scenario(
-        "lab-real-in-virtual",
-        {"scenario.duration_s": 8.0, "physical.dds_domain": domain()},
-    )
-    standins = Standins(s)
+    # the run's domain is chosen for it ("auto"): the stand-ins and the run share it
+    standins = Standins(cosim.load_scenario("lab-real-in-virtual", {"scenario.duration_s": 8.0}))
+    s = standins.scenario
+    assert isinstance(s.physical.dds_domain, int)
     standins.start()
     # the robot (and its motion capture) goes silent after 5 s of wall clock: its twin stops
     killer = threading.Timer(5.0, standins.stop)
@@ -76,17 +74,19 @@ def _odometry(x: float, y: float, *, nan: bool = False) -> Odometry:
 
 @pytest.mark.slow
 def test_samples_that_are_not_poses_jumps_and_foreign_writers_are_counted_not_used():
-    d = domain()
-    s = cosim.load_scenario(
-        "lab-room",
-        {
-            "scenario.duration_s": 3.0,
-            "robots.driver": "waypoints",
-            "physical.robots": ["robot_1"],
-            "physical.pose": "odom",
-            "physical.dds_domain": d,
-        },
+    run_domain = claim_run_domain(
+        cosim.load_scenario(
+            "lab-room",
+            {
+                "scenario.duration_s": 3.0,
+                "robots.driver": "waypoints",
+                "physical.robots": ["robot_1"],
+                "physical.pose": "odom",
+            },
+        )
     )
+    assert run_domain is not None
+    s, d = run_domain.scenario, run_domain.claim.domain
     stop = threading.Event()
 
     def robot() -> None:
@@ -112,7 +112,9 @@ def test_samples_that_are_not_poses_jumps_and_foreign_writers_are_counted_not_us
     finally:
         stop.set()
         thread.join()
+        run_domain.close()
     summary = result.summary
+    assert summary["physical_dds_domain"] == d
     assert summary["physical_invalid_samples"] >= 5
     assert summary["mocap_rejected_jumps"] >= 5
     assert summary["physical_foreign_writers"] == 1
@@ -125,3 +127,69 @@ def test_samples_that_are_not_poses_jumps_and_foreign_writers_are_counted_not_us
 def test_standins_need_a_physical_robot_in_the_scenario():
     with pytest.raises(ConfigError, match="no physical robot"):
         Standins(cosim.load_scenario("lab-room"))
+
+
+def test_standins_of_an_auto_domain_claim_one_and_tell_it_each_standin():
+    standins = Standins(cosim.load_scenario("lab-real-in-virtual"))
+    try:
+        assert standins.domain is not None
+        domain = standins.domain.claim.domain
+        assert standins.scenario.physical.dds_domain == domain
+        command = standin_command(standins.scenario, "robot_1", 1)
+        assert command[command.index("--domain") + 1] == str(domain)
+    finally:
+        standins.stop()  # gives the domain back
+    again = claim_run_domain(cosim.load_scenario("lab-real-in-virtual"))
+    assert again is not None and again.claim.domain <= domain
+    again.close()
+
+
+def test_a_standin_command_needs_the_runs_claimed_domain():
+    with pytest.raises(ConfigError, match="dds_domain = 'auto': expected the run's claimed"):
+        standin_command(cosim.load_scenario("lab-real-in-virtual"), "robot_1", 1)
+
+
+@pytest.mark.slow
+def test_a_physical_robot_that_sends_no_pose_ends_the_run_naming_it_and_where_it_was_heard_for():
+    s = cosim.load_scenario(
+        "lab-real-in-virtual", {"scenario.duration_s": 5.0, "physical.pose_timeout_s": 0.5}
+    )
+    started = time.monotonic()
+    with pytest.raises(SilentRobotError) as caught:
+        execute(s)
+    assert time.monotonic() - started < 3.0  # not the whole 5 s
+    message = str(caught.value)
+    assert message.startswith(
+        "physical robot robot_1 sent no pose for 0.5 s (since the run started): listened for "
+        "geometry_msgs/PoseStamped on /robot_1/pose on DDS domain "
+    )
+    assert message.endswith(
+        "on loopback (mocap.source = 'ros2'); expected the robot (or its stand-in, cosim run "
+        "--standin) publishing there (physical.pose_timeout_s = 0.5)"
+    )
+    assert "\n" not in message
+
+
+@pytest.mark.slow
+def test_a_run_whose_robot_never_speaks_ends_in_one_line_and_keeps_what_ran(tmp_path):
+    out = tmp_path / "run"
+    done = cosim_main(
+        "run",
+        "lab-real-in-virtual",
+        "--duration-s",
+        "5",
+        "--set",
+        "physical.pose_timeout_s=0.5",
+        "--out",
+        str(out),
+    )
+    assert done.returncode == 2
+    assert done.stderr.count("\n") == 1
+    assert done.stderr.startswith("cosim: error: physical robot robot_1 sent no pose for 0.5 s")
+    assert f'are in {out}/ (summary.json says "failed")' in done.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["failed"].startswith("physical robot robot_1 sent no pose")
+    assert 0.5 <= summary["sim_time_s"] < 5.0
+    poses = pd.read_parquet(out / "tables" / "poses.parquet")
+    assert len(poses) and poses.t_s.max() <= summary["sim_time_s"]
+    assert (out / "bag" / "metadata.yaml").is_file()

@@ -157,7 +157,7 @@ def test_invalid_scenario_files_exit_2_with_one_line_naming_the_key(tmp_path, co
         ),
         (["check", "warehouse-random", "--set", "nonsense"], "expected section.key=value"),
         (["run", "warehouse-random", "--seed", "-1"], "expected an integer >= 0"),
-        (["run", "warehouse-random", "--duration-s", "0"], "not a finite number > 0"),
+        (["run", "warehouse-random", "--duration-s", "0"], "0 is not a duration >= 1e-06"),
         (["run", "warehouse-random", "--set", "world.shelf_count=400"], "world.shelf_count = 400"),
         (
             ["check", "warehouse-random", "--set", "world.shelf_count=400"],

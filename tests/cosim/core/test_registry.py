@@ -58,6 +58,29 @@ def test_a_requirement_cycle_is_an_error_naming_the_cycle():
         REG.resolve(["loop1"])
 
 
+class _Orphan(_Adapter):
+    name = "orphan"
+    requires = ("missing",)
+
+
+def test_a_requirement_that_is_not_registered_names_the_adapter_that_requires_it():
+    registry = REG.with_adapter(_Orphan)
+    with pytest.raises(
+        RegistryError, match=r"adapter 'orphan' \(.*_Orphan\) requires unknown adapter 'missing'"
+    ):
+        registry.resolve(["a", "orphan"])
+
+
+def test_an_unknown_adapter_given_to_cosim_run_names_the_argument(small_scenario):
+    import cosim
+
+    with pytest.raises(
+        RegistryError,
+        match=r"cosim\.run\(adapters=\[\.\.\., 'nosuch', \.\.\.\]\): unknown adapter 'nosuch'",
+    ):
+        cosim.run(small_scenario, duration_s=0.1, adapters=["nosuch"])
+
+
 def test_the_installed_registry_lists_cosims_own_adapters_first_then_plugins_by_package():
     registry = AdapterRegistry.from_entry_points()
     names = registry.names()

@@ -164,7 +164,7 @@ def test_the_resolved_dump_loads_back_to_an_equal_scenario():
             "robots.placement": "explicit",
             "robots.count": 2,
             "robots.positions": [[2.0, 3.0, 0.5], [5.0, 6.0, -1.0]],
-            "scenario.name": 'a "quoted" name',
+            "record.topics": ["*", '!/a "quoted" \\ topic'],
         },
     )
     text = dump_scenario(scenario)

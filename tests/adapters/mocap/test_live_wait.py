@@ -1,0 +1,144 @@
+"""A live mocap source never blocks the run: no server, no frame, no body end it in one line."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from adapters.mocap.feed import MotionCaptureFeed
+from tests.conftest import cosim_main
+
+LIVE = (
+    "--duration-s",
+    "5",
+    "--quiet",
+    "--set",
+    "mocap.source=motioncapture",
+    "--set",
+    'mocap.bodies=[["robot_1","jackal"]]',
+)
+"""lab-room, robot_1 tracked as rigid body 'jackal' by a live system."""
+
+
+def live_run(tmp_path: Path, system: str, host: str, timeout_s: float):
+    return cosim_main(
+        "run",
+        "lab-room",
+        *LIVE,
+        "--set",
+        f"mocap.system={system}",
+        "--set",
+        f"mocap.hostname={host}",
+        "--set",
+        f"mocap.connect_timeout_s={timeout_s}",
+        "--out",
+        str(tmp_path / "run"),
+    )
+
+
+def workers() -> list[str]:
+    """Command lines of feed workers still running (any run's)."""
+    found = []
+    for proc in Path("/proc").iterdir():
+        try:
+            cmdline = (proc / "cmdline").read_bytes().replace(b"\0", b" ").decode()
+        except OSError:
+            continue
+        if "feed_worker.py" in cmdline:
+            found.append(cmdline)
+    return found
+
+
+@pytest.mark.slow
+def test_a_vicon_server_that_refuses_the_connection_ends_the_run_naming_system_host_and_wait(
+    tmp_path: Path,
+):
+    started = time.monotonic()
+    done = live_run(tmp_path, "vicon", "127.0.0.1", 0.5)
+    assert time.monotonic() - started < 4.0  # not the 5 s of the run, never forever
+    assert done.returncode == 2
+    assert done.stderr == (
+        "cosim: error: the vicon motion capture at '127.0.0.1' did not answer within 0.5 s "
+        "(no connection); expected a pose of every tracked robot within "
+        "mocap.connect_timeout_s = 0.5 s (see mocap.system, mocap.hostname and mocap.bodies); "
+        f"the results of the 0.5 s simulated are in {tmp_path / 'run'}/ "
+        '(summary.json says "failed")\n'
+    )
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    assert summary["failed"].startswith("the vicon motion capture at '127.0.0.1'")
+    assert (tmp_path / "run" / "tables" / "events.parquet").is_file()
+    assert not [w for w in workers() if "127.0.0.1" in w and "vicon" in w]
+
+
+@pytest.mark.slow
+def test_a_system_that_never_shows_the_robots_body_names_the_robot_the_body_and_the_host(
+    tmp_path: Path,
+):
+    # VRPN "connects" to a host with no server and hands out empty frames
+    done = live_run(tmp_path, "vrpn", "127.0.0.1", 2.0)
+    assert done.returncode == 2
+    line = done.stderr.removeprefix("cosim: error: ")
+    assert line.startswith(
+        "no pose of robot_1 within 2 s from the vrpn motion capture at '127.0.0.1': listened "
+        "for rigid body 'jackal' ("
+    )
+    assert "frames came, none with it); expected a pose of every tracked robot" in line
+    assert line.count("\n") == 1
+
+
+@pytest.mark.slow
+def test_a_system_the_library_refuses_ends_the_run_at_once_with_the_librarys_words(
+    tmp_path: Path,
+):
+    started = time.monotonic()
+    done = live_run(tmp_path, "qualisys", "127.0.0.1", 30.0)
+    assert time.monotonic() - started < 5.0  # long before the 30 s allowed
+    assert done.returncode == 2
+    assert done.stderr.startswith(
+        "cosim: error: the qualisys motion capture at '127.0.0.1': Error connecting QTM on "
+        "address: 127.0.0.1:22222; expected"
+    )
+
+
+def test_closing_a_feed_whose_system_never_answers_kills_its_worker_at_once():
+    feed = MotionCaptureFeed("vicon", hostname="127.0.0.1", bodies=["jackal"])
+    time.sleep(0.1)
+    assert not feed.connected and feed.failure() is None
+    started = time.monotonic()
+    feed.close()
+    assert time.monotonic() - started < 0.3
+    assert feed._process.returncode is not None
+    assert not feed._thread.is_alive()
+
+
+@pytest.mark.slow
+def test_ctrl_c_while_waiting_for_a_mocap_server_stops_the_run_at_once_keeping_what_ran(
+    tmp_path: Path,
+):
+    out = tmp_path / "run"
+    command = [sys.executable, "-m", "cosim", "run", "lab-room", *LIVE[2:]]
+    command += ["--set", "mocap.system=vicon", "--set", "mocap.hostname=127.0.0.1"]
+    command += ["--out", str(out)]
+    process = subprocess.Popen(command, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 20.0
+    while not workers() and time.monotonic() < deadline:  # the run is waiting on the system
+        time.sleep(0.05)
+    assert workers()
+    time.sleep(0.5)
+    process.send_signal(signal.SIGINT)
+    stopped = time.monotonic()
+    try:
+        _, err = process.communicate(timeout=10.0)
+    finally:
+        if process.poll() is None:
+            os.kill(process.pid, signal.SIGKILL)
+    assert time.monotonic() - stopped < 3.0  # not the 10 s connect timeout
+    assert process.returncode == 130, err
+    assert err.startswith("cosim: stopped by SIGINT at ") and err.count("\n") == 1
+    assert (out / "tables" / "mocap.parquet").is_file()
+    assert not [w for w in workers() if "127.0.0.1" in w]
