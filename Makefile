@@ -12,7 +12,7 @@ STUDY = $(BIN)/cosim study studies/$(1).toml --out $(STUDIES)/$(1) --resume
 .PHONY: setup demo test test-fast docs lint bench clean help reproduce study-comm study-comm-reduced \
 	study-burst study-scale study-paper study-nav study-mapping study-mapping-reduced \
 	study-mapping-acceptance study-mapping-drift map-aces map-fr079 \
-	lab-real lab-mixed study-humans study-humans-reduced study-traffic
+	lab-real lab-mixed study-humans study-humans-reduced study-humans-contacts study-traffic
 
 help:  ## list the targets
 	@grep -E '^[a-z-]+:.*##' $(MAKEFILE_LIST) | sed 's/:.*## /\t/'
@@ -94,6 +94,9 @@ study-humans: setup  ## robots among 0-20 SUMO-driven workers, 5 seeds x 300 s (
 
 study-humans-reduced: setup  ## robots among 0 or 10 workers, 2 seeds x 60 s
 	$(call STUDY,humans_reduced)
+
+study-humans-contacts: setup  ## do people walk into robots? 5 cases, 37 runs (about 3 min)
+	$(BIN)/python studies/humans_contacts.py --json studies/results/humans_contacts/runs_new.json
 
 ACES ?= ../shared/data/aces_lidar
 FR079 ?= ../shared/data/fr079_lidar

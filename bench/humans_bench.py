@@ -41,7 +41,8 @@ def _sumo_alone(folder: Path) -> float:
 
 
 def humans_coupling(repeat: int) -> Result:
-    """Per simulated second: the coupling (mirror robots, step SUMO, read people, metrics),
+    """Per simulated second: the coupling (mirror robots, step SUMO, read people, keep them
+    clear of robots and pace them, metrics),
     SUMO's own stepping, and the whole run with 0, 10 and 100 workers (interleaved).
 
     The whole run's extra wall time over 0 workers is split into the coupling and the rest
@@ -77,6 +78,8 @@ def humans_coupling(repeat: int) -> Result:
         },
         "near_misses": {str(n): last[n].get("humans_near_misses", 0) for n in counts},
         "replans": {str(n): last[n].get("replans") for n in counts},
+        "person_contacts": {str(n): last[n].get("humans_collisions") for n in counts[1:]},
+        "trips": {str(n): last[n].get("humans_trips") for n in counts[1:]},
         "repeat": repeat,
     }
     base = statistics.median(walls[0])

@@ -10,13 +10,17 @@ config) and keeps them for the run folder's ``sumo/``.
 1. the robots' mirrors in SUMO are placed at the robots' true poses at t_k;
 2. SUMO advances from t_(k-1) to t_k (its clock equals the kernel's after every step;
    people appear from t_1 = Δ on), its people reacting to the mirrors as placed;
-3. people and forklifts at t_k become the run's dynamic obstacles, seen by every lidar
-   and collision check until t_(k+1) (sample and hold). A person SUMO put reaching into a
-   shelf (its lane runs along the shelf's face) is first moved out until it touches it
-   (``humans_pushed_out`` counts these samples);
-4. a walker with a robot in the way stops in SUMO until the way is clear, for at most
-   ``humans.yield_s`` (:mod:`models.humans.yielding`; ``humans_yields`` counts them):
-   SUMO's own pedestrians only give way to a vehicle ahead on their lane.
+3. a person SUMO put reaching into a shelf (its lane runs along the shelf's face) is
+   moved out until it touches it (``humans_pushed_out`` counts these samples); with
+   ``humans.avoid_robots``, a walker's step from their last published position is cut
+   where it would come within a margin of a robot (``humans_steps_cut``, rare);
+4. people and forklifts at t_k become the run's dynamic obstacles, seen by every lidar
+   and collision check until t_(k+1) (sample and hold);
+5. with ``humans.avoid_robots``, each walker's speed for SUMO's next step is set by the
+   collision-free speed model (:mod:`models.humans.avoidance`, Tordeux et al. 2016):
+   slower as a robot's footprint comes nearer ahead, 0 (waiting, ``humans_yields``
+   counts these) when it is within the margin. SUMO keeps routing; its own pedestrians
+   only give way to a vehicle ahead on their lane.
 
 There is no lookahead: SUMO never runs ahead of the kernel. People react to robots with
 a delay of up to one step; between steps cosim holds a person where SUMO put them at
@@ -50,19 +54,21 @@ from adapters.humans.tables import HUMANS, HumanRecords
 from cosim.core.adapter import RunContext
 from cosim.core.kernel import Stage
 from cosim.core.recorder import TableSpec
-from cosim.core.timebase import NS_PER_S, period_ns, s_to_ns
+from cosim.core.timebase import NS_PER_S, period_ns
 from cosim.scenario.fields import model_problem
 from cosim.scenario.sections import RobotsConfig, ScenarioSection
 from models.arrays import FloatArray
 from models.errors import ModelError
 from models.humans.aisles import AisleGraph, IntArray, aisle_graph, dock_points, pick_stations
+from models.humans.avoidance import free_distance, room, safe_step, speed_limit, step_aside
 from models.humans.bodies import push_out, two_disc_cover, vehicle_centres
 from models.humans.demand import Plan, plans, standing_plans
-from models.humans.yielding import Yielding, robots_ahead
 from models.kinematics import FleetState
 from models.obstacles import DynamicObstacles
 from models.world import Warehouse
 
+WAIT_MPS = 0.05
+"""A walker the speed model limits below this is waiting for a robot (m/s)."""
 CLEARANCE_MARGIN_M = 0.1
 """Aisle lines keep a worker's radius plus this from shelves and walls (m)."""
 
@@ -152,8 +158,16 @@ class HumansAdapter:
         self.session: SumoSession | None = None
         self.steps = 0
         self.coupling_s = 0.0
-        self.yielding = Yielding(s_to_ns(cfg.yield_s))
         self.boxes = world.boxes
+        self.last_xy: dict[str, tuple[float, float]] = {}
+        """Every walker's last published position (m, ``map``)."""
+        self.cut = 0
+        """Walker steps cut short of a robot (see ``_keep_clear``)."""
+        self.yields = 0
+        self.waiting: set[str] = set()
+        self.forklift_yields = 0
+        self.forklifts_waiting: set[str] = set()
+        """Walkers the speed model holds still for a robot now."""
         self.pushed = 0
         """Person samples SUMO put reaching into a shelf or wall, moved out (see push_out)."""
 
@@ -176,23 +190,105 @@ class HumansAdapter:
         session = self.session
         session.move_robots(fleet.x, fleet.y, fleet.yaw)
         session.step(now_ns / NS_PER_S)
-        walkers = session.people()
+        robots = np.column_stack([fleet.x, fleet.y, fleet.radius_m])
+        sumo = session.people()
+        xy, pushed = push_out(
+            np.column_stack([sumo.x_m, sumo.y_m]), self.cfg.worker_radius_m, self.boxes
+        )
+        self.pushed += pushed
+        sumo = replace(sumo, x_m=xy[:, 0], y_m=xy[:, 1])
+        walkers = self._keep_clear(sumo, robots) if self.cfg.avoid_robots else sumo
         drivers = session.vehicles() if self.cfg.forklifts else None
         self._publish(walkers, drivers)
-        if self.cfg.yield_s > 0:
-            self._give_way(now_ns, session)
+        if self.cfg.avoid_robots:
+            self._pace(sumo, robots, session)
+            if drivers is not None and drivers.names:
+                self._pace_forklifts(drivers, robots, session)
         self.steps += 1
         self.coupling_s += time.perf_counter() - began
         self.records.sample(now_ns, self.people)
 
+    def _keep_clear(self, walkers: Movers, robots: FloatArray) -> Movers:
+        """Walkers where they may be seen: never walked into a robot.
+
+        SUMO's step from each walker's last published position is cut where it would come
+        within the margin of a robot (:func:`models.humans.avoidance.safe_step`); someone
+        who appears inside a robot's reach steps aside. The speed model keeps SUMO's own
+        steps clear, so a cut is the exception (``humans_steps_cut``); the walker is held
+        where the cut left them until SUMO's position is clear again.
+        """
+        n = len(walkers.names)
+        xy = np.column_stack([walkers.x_m, walkers.y_m])
+        radii = np.full(n, self.cfg.worker_radius_m)
+        last = self.last_xy
+        known = np.array([name in last for name in walkers.names], dtype=bool)
+        start = np.array(
+            [last.get(name, (np.nan, np.nan)) for name in walkers.names], dtype=float
+        ).reshape(-1, 2)
+        moved = np.zeros(n, dtype=bool)
+        if known.any():
+            xy[known], moved[known] = safe_step(start[known], xy[known], radii[known], robots)
+        if (~known).any():
+            xy[~known], moved[~known] = step_aside(xy[~known], radii[~known], robots)
+        speed = walkers.speed_mps.copy()
+        if moved.any():
+            step = np.where(known, np.hypot(*(xy - start).T), 0.0)
+            speed[moved] = np.nan_to_num(step[moved]) / (self.step_ns / NS_PER_S)
+        self.cut += int(moved.sum())
+        self.last_xy = {
+            name: (x, y) for name, (x, y) in zip(walkers.names, xy.tolist(), strict=True)
+        }
+        return replace(walkers, x_m=xy[:, 0], y_m=xy[:, 1], speed_mps=speed)
+
+    def _pace(self, walkers: Movers, robots: FloatArray, session: SumoSession) -> None:
+        """Each walker's speed for SUMO's next step: the collision-free speed model."""
+        staying = walkers.staying if walkers.staying is not None else np.zeros(0, dtype=bool)
+        rows = np.flatnonzero(~staying)
+        if len(rows) == 0:
+            return
+        xy = np.column_stack([walkers.x_m[rows], walkers.y_m[rows]])
+        yaw = walkers.yaw_rad[rows]
+        radii = np.full(len(rows), self.cfg.worker_radius_m)
+        limit = speed_limit(
+            free_distance(xy, yaw, radii, robots),
+            np.full(len(rows), np.inf),
+            room_m=room(xy, yaw, radii, robots),
+            step_s=self.step_ns / NS_PER_S,
+        )
+        names = [walkers.names[k] for k in rows.tolist()]
+        session.pace(names, limit)
+        stopped = {name for name, v in zip(names, limit.tolist(), strict=True) if v < WAIT_MPS}
+        self.yields += len(stopped - self.waiting)
+        self.waiting = stopped
+
+    def _pace_forklifts(self, drivers: Movers, robots: FloatArray, session: SumoSession) -> None:
+        """Each forklift's speed for SUMO's next step: the same speed model, front disc ahead.
+
+        SUMO's car-following brakes only for a robot's mirror ahead on the forklift's own
+        lane; the speed model sees every robot's true footprint, beside the lane and on
+        junctions too.
+        """
+        n = len(drivers.names)
+        length, width = self.cfg.forklift_size_m
+        cx, cy = vehicle_centres(drivers.x_m, drivers.y_m, drivers.yaw_rad, length)
+        front = two_disc_cover(cx, cy, drivers.yaw_rad, length, width)[:n]
+        limit = speed_limit(
+            free_distance(front[:, :2], drivers.yaw_rad, front[:, 2], robots),
+            np.full(n, np.inf),
+            room_m=room(front[:, :2], drivers.yaw_rad, front[:, 2], robots),
+            step_s=self.step_ns / NS_PER_S,
+        )
+        session.pace_vehicles(drivers.names, limit)
+        stopped = {
+            name for name, v in zip(drivers.names, limit.tolist(), strict=True) if v < WAIT_MPS
+        }
+        self.forklift_yields += len(stopped - self.forklifts_waiting)
+        self.forklifts_waiting = stopped
+
     def _publish(self, walkers: Movers, drivers: Movers | None) -> None:
         cfg = self.cfg
         people = self.people
-        xy, pushed = push_out(
-            np.column_stack([walkers.x_m, walkers.y_m]), cfg.worker_radius_m, self.boxes
-        )
-        self.pushed += pushed
-        walkers = replace(walkers, x_m=xy[:, 0], y_m=xy[:, 1])
+        xy = np.column_stack([walkers.x_m, walkers.y_m])
         discs = [np.column_stack([xy, np.full(len(walkers.names), cfg.worker_radius_m)])]
         names = list(walkers.names)
         kinds = ["person"] * len(names)
@@ -219,32 +315,6 @@ class HumansAdapter:
         people.yaw_rad = np.concatenate(yaw)
         people.speed_mps = np.concatenate(speed)
 
-    def _give_way(self, now_ns: int, session: SumoSession) -> None:
-        """Stop walkers with a robot in their way; let them go when clear or tired of it."""
-        people = self.people
-        walkers = [k for k, kind in enumerate(people.kinds) if kind == "person"]
-        fleet = self.fleet
-        discs = np.column_stack(
-            [
-                people.x_m[walkers],
-                people.y_m[walkers],
-                np.full(len(walkers), self.cfg.worker_radius_m),
-            ]
-        )
-        blocked = robots_ahead(
-            discs,
-            people.yaw_rad[walkers],
-            self.cfg.worker_speed_mps,
-            np.column_stack([fleet.x, fleet.y, fleet.radius_m]),
-        )
-        names = [people.names[k] for k in walkers]
-        walking = people.speed_mps[walkers] > 0.0
-        stop, go = self.yielding.update(now_ns, names, blocked, walking)
-        if go:
-            session.release(go)
-        if stop:
-            session.hold(stop)
-
     def close(self) -> None:
         """Stop SUMO and keep its files (and log) for the run folder's ``sumo/``."""
         if self.session is not None:
@@ -265,7 +335,10 @@ class HumansAdapter:
                 "humans_forklifts": self.cfg.forklifts,
                 "humans_sumo_steps": self.steps,
                 "humans_pushed_out": self.pushed,
-                "humans_yields": self.yielding.yields,
+                "humans_yields": self.yields,
+                "humans_steps_cut": self.cut,
+                "humans_forklift_yields": self.forklift_yields,
+                "humans_trips": self.session.arrivals if self.session else 0,
                 "humans_coupling_wall_s": round(self.coupling_s, 4),
                 "humans_sumo_in_process": bool(self.session and self.session.in_process),
             }

@@ -24,6 +24,7 @@ from typing import Any
 
 import libsumo
 import numpy as np
+import numpy.typing as npt
 import traci
 from traci import constants as tc
 
@@ -41,12 +42,22 @@ SUMO_ERRORS: tuple[type[BaseException], ...] = (
 """What libsumo and TraCI raise."""
 STAGE_WAITING = 1
 """TraCI's stage type of a person staying somewhere."""
-PERSON_VARS = (tc.VAR_POSITION, tc.VAR_ANGLE, tc.VAR_SPEED, tc.VAR_ROAD_ID, tc.VAR_LANEPOSITION)
+PERSON_VARS = (
+    tc.VAR_POSITION,
+    tc.VAR_ANGLE,
+    tc.VAR_SPEED,
+    tc.VAR_ROAD_ID,
+    tc.VAR_LANEPOSITION,
+    tc.VAR_STAGES_REMAINING,
+)
 VEHICLE_VARS = (tc.VAR_POSITION, tc.VAR_ANGLE, tc.VAR_SPEED)
 
 MATCH_THRESHOLD_M = 4.0
 """How far from a robot SUMO first looks for a lane to put its mirror on (m): the search
 costs in proportion (SUMO's default, 100 m, is the fallback)."""
+
+PACE_STEP_MPS = 0.02
+"""Smallest change of a walker's speed limit passed on to SUMO (m/s)."""
 
 _LIBSUMO = threading.Lock()
 """Held by the session that runs in this process through libsumo."""
@@ -62,6 +73,8 @@ class Movers:
         x_m, y_m: positions (m): a person's position, a vehicle's front centre.
         yaw_rad: headings (rad, counter-clockwise from +x).
         speed_mps: speeds (m/s).
+        staying: for people, who stays somewhere (a pick station, the dock) rather than
+            walks; ``None`` for vehicles.
     """
 
     names: list[str]
@@ -69,6 +82,7 @@ class Movers:
     y_m: FloatArray
     yaw_rad: FloatArray
     speed_mps: FloatArray
+    staying: npt.NDArray[np.bool_] | None = None
 
 
 def yaw_of_angle(angle_deg: FloatArray) -> FloatArray:
@@ -126,7 +140,13 @@ class SumoSession:
         self._vehicles: set[str] = set()
         self._waiting: dict[tuple[str, float], tuple[float, float]] = {}
         self._robots: list[str] = []
-        self._held: dict[str, float] = {}
+        self._remaining: dict[str, int] = {}
+        self._own_speed: dict[str, tuple[float, float]] = {}
+        self._paced: dict[str, float] = {}
+        self._top_speed: dict[str, float] = {}
+        self._paced_vehicles: dict[str, float] = {}
+        self.arrivals = 0
+        """Walks that ended at a place where the person stays (a pick station, the dock)."""
 
     @contextlib.contextmanager
     def errors(self, doing: str) -> Iterator[None]:
@@ -177,23 +197,50 @@ class SumoSession:
                 except SUMO_ERRORS:  # no lane that close: look as far as SUMO does
                     move(name, "", -1, x, y, angle, 2)
 
-    def hold(self, names: Sequence[str]) -> None:
-        """Stop these walkers where they are (their walking speed kept for :meth:`release`)."""
-        person = self._api.person
-        with self.errors("stop a person"):
-            for name in names:
-                self._held[name] = float(person.getMaxSpeed(name))
-                person.setSpeed(name, 0.0)
+    def pace(self, names: Sequence[str], speed_mps: FloatArray) -> None:
+        """Let these walkers walk at most this fast (m/s) from the next step on.
 
-    def release(self, names: Sequence[str]) -> None:
-        """Let walkers stopped by :meth:`hold` walk on at their own speed."""
+        A walker's own speed (their type's) and speed factor (SUMO's individual deviation)
+        are kept the first time they are paced; a limit at or above it gives it back, one below
+        ``PACE_STEP_MPS`` stops them. SUMO is asked only when a walker's limit changes by
+        more than ``PACE_STEP_MPS`` or reaches 0 or their own speed.
+        """
         person = self._api.person
-        present = set(person.getIDList())
-        with self.errors("let a person walk on"):
-            for name in names:
-                speed = self._held.pop(name, None)
-                if speed is not None and name in present:
-                    person.setSpeed(name, speed)
+        with self.errors("set a person's speed"):
+            for name, limit in zip(names, speed_mps.tolist(), strict=True):
+                found = self._own_speed.get(name)
+                if found is None:
+                    found = (float(person.getMaxSpeed(name)), float(person.getSpeedFactor(name)))
+                    self._own_speed[name] = found
+                own, factor = found
+                # SUMO walks a person at the speed set times their own speed factor; below
+                # the step a walker stands: a small limit left in place would let them creep
+                limit = min(limit / factor, own) if limit >= PACE_STEP_MPS else 0.0
+                last = self._paced.get(name, own)
+                if abs(limit - last) > PACE_STEP_MPS or (limit != last and limit in (0.0, own)):
+                    person.setSpeed(name, limit)
+                    self._paced[name] = limit
+
+    def pace_vehicles(self, names: Sequence[str], speed_mps: FloatArray) -> None:
+        """Let these forklifts drive at most this fast (m/s) from the next step on.
+
+        A limit at or above a forklift's own top speed (or ``inf``) hands its speed back to
+        SUMO's car-following; a lower one is set with ``vehicle.setSpeed`` (SUMO brakes
+        within the type's ``decel``), one below ``PACE_STEP_MPS`` stops it. SUMO is asked
+        only when a limit changes by more than ``PACE_STEP_MPS``, stops or frees it.
+        """
+        vehicle = self._api.vehicle
+        with self.errors("set a forklift's speed"):
+            for name, limit in zip(names, speed_mps.tolist(), strict=True):
+                top = self._top_speed.get(name)
+                if top is None:
+                    top = self._top_speed[name] = float(vehicle.getMaxSpeed(name))
+                target = -1.0 if limit >= top else (limit if limit >= PACE_STEP_MPS else 0.0)
+                last = self._paced_vehicles.get(name, -1.0)
+                changed = abs(target - last) > PACE_STEP_MPS
+                if changed or (target != last and (target == 0.0 or -1.0 in (target, last))):
+                    vehicle.setSpeed(name, target)
+                    self._paced_vehicles[name] = target
 
     def step(self, until_s: float) -> None:
         """Advance SUMO to ``until_s`` (s) and subscribe to whoever appeared."""
@@ -216,6 +263,7 @@ class SumoSession:
             y = np.empty(len(names))
             angle = np.empty(len(names))
             speed = np.empty(len(names))
+            staying = np.zeros(len(names), dtype=bool)
             for k, name in enumerate(names):
                 values = found[name]
                 (x[k], y[k]), angle[k], speed[k] = (
@@ -223,11 +271,16 @@ class SumoSession:
                     values[tc.VAR_ANGLE],
                     values[tc.VAR_SPEED],
                 )
-                if speed[k] == 0.0 and api.person.getStage(name).type == STAGE_WAITING:
+                remaining = int(values[tc.VAR_STAGES_REMAINING])
+                ended = remaining < self._remaining.get(name, remaining)
+                self._remaining[name] = remaining
+                if (speed[k] == 0.0 or ended) and api.person.getStage(name).type == STAGE_WAITING:
                     # SUMO draws a person who stays somewhere 3 m beside the lane; they
                     # stand on it
                     x[k], y[k] = self._on_lane(values[tc.VAR_ROAD_ID], values[tc.VAR_LANEPOSITION])
-        return Movers(names, x, y, yaw_of_angle(angle), speed)
+                    self.arrivals += ended
+                    staying[k] = True
+        return Movers(names, x, y, yaw_of_angle(angle), speed, staying)
 
     def _on_lane(self, edge: str, position: float) -> tuple[float, float]:
         key = (edge, position)

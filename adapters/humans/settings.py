@@ -68,12 +68,11 @@ class HumansConfig:
         "pedestrian.striping.jamtime; SUMO's default, 300 s, is for streets) (s)",
         gt=0,
     )
-    yield_s: float = param(
-        10.0,
-        "a walker with a robot in the way stops for it at most this long, then walks on "
-        "(and does not stop again for as long); 0: people never stop for robots beyond what "
-        "SUMO's pedestrians do by themselves (s)",
-        ge=0,
+    avoid_robots: bool = param(
+        True,
+        "people keep clear of robots, moving or standing (a collision-free speed model over "
+        "SUMO's walking: a walker slows and waits rather than walk into a robot); false: only "
+        "SUMO's own pedestrians' giving way to a robot's mirror ahead on their lane",
     )
     record_hz: float = param(
         10.0, "rows per second and person in tables/humans (capped by the SUMO step)", gt=0

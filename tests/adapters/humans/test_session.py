@@ -1,3 +1,4 @@
+import itertools
 import threading
 
 import numpy as np
@@ -107,7 +108,7 @@ def test_a_robot_far_from_every_lane_is_still_mirrored_where_it_is(sumo_files):
         session.close()
 
 
-def test_a_held_walker_stands_still_and_walks_on_at_their_own_speed_when_released(
+def test_a_paced_walker_stops_at_zero_and_walks_on_at_their_own_speed_when_freed(
     walkers_only,
 ):
     session = SumoSession(walkers_only, seed=1)
@@ -118,19 +119,59 @@ def test_a_held_walker_stands_still_and_walks_on_at_their_own_speed_when_release
         k_walking = int(np.argmax(people.speed_mps))
         name = people.names[k_walking]
         assert people.speed_mps[k_walking] > 0.5
+        assert people.staying is not None and not people.staying[k_walking]
         own = session._api.person.getMaxSpeed(name)
-        session.hold([name])
+        session.pace([name], np.array([0.01]))  # below the pace step: standing
         for k in range(60, 90):
             session.step(k * 0.1)
         held = session.people()
         at = held.names.index(name)
         assert held.speed_mps[at] == 0.0
-        session.release([name])
+        assert (held.x_m[at], held.y_m[at]) == (people.x_m[k_walking], people.y_m[k_walking])
+        session.pace([name], np.array([0.4]))
+        paced = []
+        for k in range(90, 96):
+            session.step(k * 0.1)
+            paced.append(session._api.person.getSpeed(name))
+        assert 0.25 < max(paced) <= 0.4 + 1e-9, paced  # never faster than the limit
+        session.pace([name], np.array([np.inf]))
         assert session._api.person.getMaxSpeed(name) == pytest.approx(own)
         speeds = []
-        for k in range(90, 100):
+        for k in range(96, 110):
             session.step(k * 0.1)
             speeds.append(session._api.person.getSpeed(name))
         assert max(speeds) > 0.5, speeds
+    finally:
+        session.close()
+
+
+def test_a_paced_forklift_brakes_to_a_stop_and_drives_on_when_freed(sumo_files):
+    session = SumoSession(sumo_files, seed=1)
+    try:
+        k = 1
+        while k < 300:  # until some forklift drives
+            session.step(k * 0.1)
+            k += 1
+            drivers = session.vehicles()
+            if len(drivers.names) and drivers.speed_mps.max() > 1.0:
+                break
+        fast = int(np.argmax(drivers.speed_mps))
+        name = drivers.names[fast]
+        assert drivers.speed_mps[fast] > 1.0
+        session.pace_vehicles([name], np.array([0.0]))
+        speeds = []
+        for j in range(k, k + 20):
+            session.step(j * 0.1)
+            speeds.append(session._api.vehicle.getSpeed(name))
+        assert speeds[-1] == 0.0, speeds
+        # braking within the type's 2 m/s^2: no step loses more than 0.2 m/s
+        assert all(a - b <= 0.2 + 1e-9 for a, b in itertools.pairwise(speeds)), speeds
+        session.pace_vehicles([name], np.array([np.inf]))
+        freed = []
+        for j in range(k + 20, k + 50):
+            session.step(j * 0.1)
+            if name in session.vehicles().names:
+                freed.append(session._api.vehicle.getSpeed(name))
+        assert max(freed) > 0.5, freed
     finally:
         session.close()
