@@ -22,9 +22,12 @@ $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	$(BIN)/python -m cosim.runner.warmup
 	touch $(STAMP)
 
-setup: $(STAMP)  ## create .venv and install cosim with its dev tools
+# the warm-up compiles the numba kernels once (about 20 s) into their cache (__pycache__ next
+# to each module), so that the first `make demo` shows the real speed
+setup: $(STAMP)  ## create .venv, install cosim with its dev tools, compile the numba kernels
 
 demo: setup  ## run the default scenario and say where the results are
 	$(BIN)/cosim run $(SCENARIO) --out $(OUT) --force
@@ -49,11 +52,14 @@ bench: setup  ## benchmarks -> bench/results.json
 
 reproduce: setup  ## Scenarios 1-3, reduced comm sweep, map sharing and people (about 8 min on 2 cores)
 	$(call STUDY,paper)
+	$(BIN)/cosim run warehouse-random --figures --force --quiet --out runs/paper-scenario1-random
+	$(BIN)/cosim run warehouse-rows --figures --force --quiet --out runs/paper-scenario1-racks
 	$(call STUDY,comm_sweep_reduced)
 	$(call STUDY,map_sharing_reduced)
 	$(call STUDY,humans_reduced)
 	$(MAKE) --no-print-directory lab-real lab-mixed
 	@echo "reports: $(STUDIES)/paper/report.md $(STUDIES)/comm_sweep_reduced/report.md $(STUDIES)/map_sharing_reduced/report.md $(STUDIES)/humans_reduced/report.md"
+	@echo "scenario 1: runs/paper-scenario1-random/figures runs/paper-scenario1-racks/figures"
 	@echo "mixed reality: runs/lab-real-in-virtual/figures runs/lab-mixed/figures"
 
 lab-real: setup  ## Scenario 2: a stand-in physical robot through goals among virtual obstacles (1 min, real time)

@@ -190,7 +190,12 @@ def build_parser() -> argparse.ArgumentParser:
         help="start a stand-in robot process (cosim standin) for every physical robot of "
         "the scenario, so mixed-reality scenarios run without hardware",
     )
-    run.add_argument("--out", type=_folder, help="results folder (default: runs/NAME-seedN)")
+    run.add_argument(
+        "--out",
+        type=_folder,
+        help="results folder (default: runs/NAME-seedN, or runs/NAME-seedN-2, -3, ... when "
+        "that one holds a run)",
+    )
     run.add_argument("--seed", type=_non_negative_int, help="override scenario.seed")
     run.add_argument(
         "--duration-s",
@@ -201,7 +206,8 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument(
         "--force",
         action="store_true",
-        help="replace the results of an earlier run in a non-empty --out (other files stay)",
+        help="replace the results of an earlier run in a non-empty --out (default: "
+        "runs/NAME-seedN); other files stay, and figures/ too unless --figures/--gif redraw it",
     )
     run.add_argument("--quiet", action="store_true", help="print nothing but errors")
     run.add_argument(

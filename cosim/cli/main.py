@@ -124,9 +124,9 @@ def _run_and_report(args: argparse.Namespace, stop: StopRequest, ran: list[Path]
     scenario = _load(args)
     if args.seed is not None:
         scenario = scenario.with_seed(args.seed)
-    out = args.out or Path("runs") / f"{scenario.name}-seed{scenario.seed}"
     if args.live:
         check_live_host(args.live_host)
+    out = _out_folder(args, scenario, quiet=args.quiet)
     live = (
         LiveOptions(args.live_host, args.live_port, args.live_rate, args.live_wait)
         if args.live
@@ -139,8 +139,9 @@ def _run_and_report(args: argparse.Namespace, stop: StopRequest, ran: list[Path]
         if not args.quiet:
             print(domain.claim.describe(), flush=True)
     progress = None if args.quiet else ProgressLine(label=f"{scenario.name}: ")
-    standins = Standins(scenario) if args.standin else None
+    standins = None
     try:
+        standins = Standins(scenario) if args.standin else None
         if standins is not None:
             started = standins.start()
             if not args.quiet:
@@ -155,6 +156,7 @@ def _run_and_report(args: argparse.Namespace, stop: StopRequest, ran: list[Path]
                 live=live,
                 on_ready=lambda session: _ready(session, quiet=args.quiet),
                 stop=stop,
+                figures=args.figures or args.gif,
             )
         except RunStopped as stopped:
             if stopped.result is not None and stopped.result.out is not None:
@@ -176,6 +178,28 @@ def _run_and_report(args: argparse.Namespace, stop: StopRequest, ran: list[Path]
     if not args.quiet:
         _print_run(result, out, figures)
     return EXIT_OK
+
+
+def _out_folder(args: argparse.Namespace, scenario: Scenario, *, quiet: bool) -> Path:
+    """``--out``, or ``runs/NAME-seedN`` numbered (``-2``, ...) when that one holds a run.
+
+    With ``--force`` and no ``--out``, ``runs/NAME-seedN`` itself (its earlier run replaced).
+    """
+    from cosim.runner.outfolder import default_out
+
+    if args.out is not None:
+        return Path(args.out)
+    base = Path("runs") / f"{scenario.name}-seed{scenario.seed}"
+    if args.force:
+        return base
+    out = default_out(base)
+    if out != base and not quiet:
+        print(
+            f"results folder: {out}/ ({base}/ holds an earlier run; "
+            "--out DIR chooses, --force replaces it)",
+            flush=True,
+        )
+    return out
 
 
 def _stopped_line(stopped: RunStopped, ran: list[Path]) -> str:
@@ -213,12 +237,12 @@ def _ready(session: RecordingSession, *, quiet: bool) -> None:
 
 
 def _print_run(result: RunResult, out: Path, figures: list[Path]) -> None:
+    from cosim.runner.compiletime import speed_phrase
+
     s = result.summary
-    factor = s.get("real_time_factor")
-    rate = f"{factor:.3g}x real time" if factor is not None else "real-time factor unknown"
+    speed = speed_phrase(s["sim_time_s"], s["wall_time_s"], result.compile_time_s)
     print(
-        f"{s['scenario']} seed {s['seed']}: {s['sim_time_s']:g} s simulated in "
-        f"{s['wall_time_s']:.2f} s ({rate}), "
+        f"{s['scenario']} seed {s['seed']}: {speed}, "
         f"{s['robots']} robots, {s['events']:,} events, {s['messages_sent']:,} messages"
     )
     tasks = _tasks_phrase(s)
@@ -242,6 +266,8 @@ def _print_run(result: RunResult, out: Path, figures: list[Path]) -> None:
         )
     if figures:
         print(f"figures: {', '.join(str(f) for f in figures)}")
+    elif (out / "figures").is_dir() and any((out / "figures").iterdir()):
+        print(f"figures/: kept from before, not of this run (`cosim plot {out}` redraws them)")
 
 
 def _cmd_check(args: argparse.Namespace) -> int:

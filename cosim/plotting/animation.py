@@ -21,6 +21,7 @@ from PIL import Image
 from cosim.core.errors import ExportError
 from cosim.plotting.canvas import Color, fleet_colors
 from cosim.plotting.fleet import FleetLayer, fleet_handles
+from cosim.plotting.goals import GOAL_FACE, GoalLayer, goal_handles
 from cosim.plotting.people import PeopleLayer, people_handles, people_inks
 from cosim.plotting.rays import LidarRays
 from cosim.plotting.rundata import RunData
@@ -83,6 +84,7 @@ def animation_gif(
     ax = figure.add_subplot()
     draw_world(ax, run.warehouse, shelf_color=SHELF_MUTED)
     layer = FleetLayer(ax, run, colors, label_robots=False)  # unreadable at GIF resolution
+    goals = GoalLayer(ax, run, colors)
     people = PeopleLayer(ax, run)
     rays = LidarRays(run, lidar_robot, max_rays=90)
     beams = LineCollection([], colors=RAY_COLOR, linewidths=0.4, alpha=0.5, zorder=2)
@@ -95,6 +97,7 @@ def animation_gif(
     lidar = Line2D([], [], color=RAY_COLOR, lw=0.8, label=f"lidar, {track.robots[lidar_robot]}")
     handles = [
         *fleet_handles(run, colors),
+        *goal_handles(run),
         *people_handles(run),
         lidar,
         *world_handles(run.warehouse, shelf_color=SHELF_MUTED),
@@ -102,6 +105,7 @@ def animation_gif(
     figure.legend(handles=handles, loc="outside right upper", fontsize=8)
 
     moving = [beams, hits, *people.show(float(track.t_s[indices[0]])), *layer.show(indices[0])]
+    moving += [goals.links, goals.markers]
     moving.append(clock)
     for artist in moving:
         artist.set_animated(True)
@@ -116,6 +120,7 @@ def animation_gif(
         SHELF_MUTED,
         OBSTACLE_COLOR,
         *people_inks(run),
+        *([GOAL_FACE] if goal_handles(run) else []),
         *INKS,
     ]
     palette = _palette(inks, robots=len(colors))
@@ -127,7 +132,9 @@ def animation_gif(
         hits.set_offsets(ends[hit] if hit.any() else np.zeros((0, 2)))
         clock.set_text(f"t = {track.t_s[i]:5.1f} s   ({speedup:g}x real time)")
         people_now = people.show(float(track.t_s[i]))
-        for artist in [beams, hits, *people_now, *layer.show(i), clock]:  # in z order
+        goals.show(float(track.t_s[i]), track.x_m[i], track.y_m[i])
+        drawn = [beams, hits, goals.links, goals.markers, *people_now, *layer.show(i), clock]
+        for artist in drawn:  # in z order
             ax.draw_artist(artist)
         pixels = np.asarray(canvas.buffer_rgba())  # type: ignore[no-untyped-call]
         rgb = Image.fromarray(pixels).convert("RGB")

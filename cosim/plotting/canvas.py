@@ -3,15 +3,20 @@
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from matplotlib import colormaps
 from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.colors import hsv_to_rgb
 from matplotlib.figure import Figure
 
 from cosim.core.errors import ExportError
+
+if TYPE_CHECKING:
+    from cosim.plotting.rundata import RunData
 
 DPI = 150
 """Resolution of PNG figures (dots per inch)."""
@@ -50,34 +55,55 @@ def robot_order(names: Iterable[str]) -> list[str]:
     return sorted(set(names), key=key)
 
 
-def robot_colors(count: int) -> list[Color]:
-    """A distinct colour per robot: Tableau's 10 or 20 for small fleets, turbo beyond.
-
-    Turbo is cut at both ends: its darkest blue and red are hard to tell from walls.
-    """
-    if count <= 10:
-        return [colormaps["tab10"](i) for i in range(count)]
-    if count <= 20:
-        return [colormaps["tab20"](i) for i in range(count)]
-    return [colormaps["turbo"](float(v)) for v in np.linspace(0.08, 0.92, count)]
-
-
 PHYSICAL_COLOR: Color = (0.84, 0.15, 0.16, 1.0)
-"""A physical robot's twin, red as in the paper's mixed-reality figures."""
+"""A physical robot's twin, red as in the paper's mixed-reality figures (and only it)."""
+_TAB10_NOT_RED = (0, 1, 2, 4, 5, 6, 8, 9, 7)
+"""Tableau 10 without its red (index 3), grey last (it is also the colour of 'no robot')."""
+_TAB20_NOT_RED = tuple(i for i in range(20) if i not in (6, 7))
+"""Tableau 20 without its red pair."""
+HUE_SPAN = (0.1, 0.9)
+"""Hues (HSV, 0 and 1 are red) of the colour wheel of large fleets: red left out."""
 
 
-def fleet_colors(robots: list[str], physical: tuple[str, ...]) -> list[Color]:
-    """Colours of a fleet, robot by robot.
+def robot_colors(count: int) -> list[Color]:
+    """``count`` distinct colours, none of them red (red is the physical robots').
 
-    With physical robots, their twins are red and the virtual robots shades of green (the
-    paper's convention); otherwise every robot gets a distinct colour.
+    Tableau 10 without red for up to 9, Tableau 20 without its red pair for up to 18, and
+    beyond a wheel of hues from orange to magenta in three brightness levels.
     """
-    if not physical:
-        return robot_colors(len(robots))
-    virtual = [r for r in robots if r not in physical]
-    greens = [colormaps["Greens"](float(v)) for v in np.linspace(0.85, 0.45, max(len(virtual), 1))]
-    shade = iter(greens)
-    return [PHYSICAL_COLOR if r in physical else next(shade) for r in robots]
+    if count <= len(_TAB10_NOT_RED):
+        return [colormaps["tab10"](i) for i in _TAB10_NOT_RED[:count]]
+    if count <= len(_TAB20_NOT_RED):
+        return [colormaps["tab20"](i) for i in _TAB20_NOT_RED[:count]]
+    hues = np.linspace(*HUE_SPAN, count)
+    values = (0.95, 0.7, 0.82)
+    colors: list[Color] = []
+    for k, hue in enumerate(hues):
+        r, g, b = hsv_to_rgb((float(hue), 0.85, values[k % 3]))
+        colors.append((float(r), float(g), float(b), 1.0))
+    return colors
+
+
+def fleet_colors(robots: Sequence[str], physical: Iterable[str] = ()) -> list[Color]:
+    """The colour of each robot of a run, in the order of ``robots``: every figure uses it.
+
+    The physical robots (their twins) are red, as in the paper's mixed-reality figures;
+    the virtual robots take, in fleet order, the distinct colours of :func:`robot_colors`,
+    which has no red. A robot's colour depends only on the fleet and which robots are
+    physical, so it is the same in every figure and frame of a run.
+
+    Args:
+        robots: robot names in fleet order (``RunData.track.robots``).
+        physical: names of the physical robots (``scenario.physical.robots``).
+    """
+    physical = set(physical)
+    virtual = iter(robot_colors(sum(1 for r in robots if r not in physical)))
+    return [PHYSICAL_COLOR if r in physical else next(virtual) for r in robots]
+
+
+def run_colors(run: RunData) -> list[Color]:
+    """:func:`fleet_colors` of a run's fleet (``run.track.robots``)."""
+    return fleet_colors(list(run.track.robots), run.scenario.physical.robots)
 
 
 def short_label(robot: str) -> str:

@@ -20,6 +20,10 @@ SNAPSHOTS_DEFAULT = 4
 """Snapshots drawn when no time is given."""
 SNAPSHOTS_MAX = 12
 """Most snapshot times accepted."""
+PAPER_TIMES_S: dict[str, tuple[float, ...]] = {"lab-mixed": (25.0,)}
+"""Snapshot times of the paper's figures, by scenario name, added to the default times: the
+paper's Scenario 3 (preset ``lab-mixed``) shows the fleet at t = 25 s (VirTooS, Fig. 'Snapshot
+of the mixed-reality experiment at t = 25 s')."""
 
 
 def plot_run(
@@ -85,7 +89,9 @@ def plot_run(
 def snapshot_times(run: RunData, at: Sequence[float] | None) -> list[float]:
     """The snapshot times (s): ``at`` checked against the run, or evenly spaced ones.
 
-    The defaults are ``duration * k / 4`` for k = 1..4, each at most the last pose's time.
+    The defaults are ``duration * k / 4`` for k = 1..4, each at most the last pose's time,
+    plus, for a scenario of the paper, the times of its figures within the run
+    (:data:`PAPER_TIMES_S`: t = 25 s for ``lab-mixed``), in time order.
 
     Raises:
         ExportError: ``at`` is empty, too long, or has a time that is not a number between
@@ -94,7 +100,9 @@ def snapshot_times(run: RunData, at: Sequence[float] | None) -> list[float]:
     first, last = float(run.track.t_s[0]), float(run.track.t_s[-1])
     end = max(last, run.scenario.scenario.duration_s)
     if at is None:
-        return [min(end * k / SNAPSHOTS_DEFAULT, last) for k in range(1, SNAPSHOTS_DEFAULT + 1)]
+        even = [min(end * k / SNAPSHOTS_DEFAULT, last) for k in range(1, SNAPSHOTS_DEFAULT + 1)]
+        paper = PAPER_TIMES_S.get(run.scenario.name, ())
+        return sorted({*even, *(t for t in paper if first <= t <= last)})
     times = list(at)
     if not 1 <= len(times) <= SNAPSHOTS_MAX:
         raise ExportError(f"{run.path}: {len(times)} snapshot times: expected 1 to {SNAPSHOTS_MAX}")

@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import pandas as pd
 from matplotlib.artist import Artist
 from matplotlib.axes import Axes
 from matplotlib.collections import EllipseCollection, LineCollection, PathCollection
@@ -27,59 +28,75 @@ WAITING_COLOR = "white"
 
 @dataclass(frozen=True)
 class TaskTimes:
-    """The tasks of a run as arrays (times in s; NaN: not yet / never).
+    """The tasks of a run and who held them when, as arrays (times in s; NaN: never).
 
     Attributes:
         xy: (k, 2) task stations in ``map`` (m).
         created: (k,) creation times (s).
-        assigned: (k,) times the final holder was assigned (s).
-        started: (k,) service start times (s).
         completed: (k,) completion times (s).
-        holder: (k,) fleet index of the holder (``RunData.tasks.holder``), -1 for none.
+        served_by: (k,) fleet index of the robot that served the task, -1 for none.
+        hold_task: (h,) task row of each holding (``RunData.holds``).
+        hold_robot: (h,) fleet index of the holding robot.
+        hold_from: (h,) start of each holding (s).
+        hold_to: (h,) its end (s; inf: held to the end of the run).
     """
 
     xy: FloatArray
     created: FloatArray
-    assigned: FloatArray
-    started: FloatArray
     completed: FloatArray
-    holder: IntArray
+    served_by: IntArray
+    hold_task: IntArray
+    hold_robot: IntArray
+    hold_from: FloatArray
+    hold_to: FloatArray
 
     @classmethod
     def of(cls, run: RunData) -> TaskTimes:
         """The run's tasks (none when it has no tasks table)."""
-        tasks = run.tasks
+        tasks, holds = run.tasks, run.holds
         if tasks is None:
             return cls.of_none()
         index = {name: i for i, name in enumerate(run.track.robots)}
-
-        def times(column: str) -> FloatArray:
-            values: FloatArray = tasks[column].to_numpy(np.float64)
-            return values
-
+        row = {float(k): i for i, k in enumerate(tasks["task"])}
+        if holds is None or holds.empty:
+            holds = pd.DataFrame({"task": [], "robot": [], "t_from_s": [], "t_to_s": []})
+        known = [
+            float(k) in row and str(r) in index
+            for k, r in zip(holds["task"], holds["robot"], strict=True)
+        ]
+        holds = holds[np.array(known, dtype=bool)] if len(holds) else holds
         return cls(
             xy=tasks[["x_m", "y_m"]].to_numpy(np.float64),
-            created=times("t_created_s"),
-            assigned=times("t_assigned_s"),
-            started=times("t_started_s"),
-            completed=times("t_completed_s"),
-            holder=np.array([index.get(r, -1) for r in tasks["holder"]], dtype=np.int64),
+            created=tasks["t_created_s"].to_numpy(np.float64),
+            completed=tasks["t_completed_s"].to_numpy(np.float64),
+            served_by=np.array([index.get(str(r), -1) for r in tasks["robot"]], dtype=np.int64),
+            hold_task=np.array([row[float(k)] for k in holds["task"]], dtype=np.int64),
+            hold_robot=np.array([index[str(r)] for r in holds["robot"]], dtype=np.int64),
+            hold_from=holds["t_from_s"].to_numpy(np.float64),
+            hold_to=np.nan_to_num(holds["t_to_s"].to_numpy(np.float64), nan=np.inf),
         )
 
     @classmethod
     def of_none(cls) -> TaskTimes:
         """No task."""
         empty = np.zeros(0)
-        return cls(np.zeros((0, 2)), empty, empty, empty, empty, np.zeros(0, dtype=np.int64))
+        none = np.zeros(0, dtype=np.int64)
+        return cls(np.zeros((0, 2)), empty, empty, none, none, none, empty, empty)
 
     def open_at(self, t_s: float) -> BoolArray:
         """Tasks created and not completed at ``t_s`` (NaN compares false: never completed)."""
         done: BoolArray = self.completed <= t_s
         return (self.created <= t_s) & ~done
 
-    def held_at(self, t_s: float) -> BoolArray:
-        """Tasks whose (final) holder has them at ``t_s``."""
-        return (self.holder >= 0) & (self.assigned <= t_s)
+    def holders_at(self, t_s: float) -> IntArray:
+        """(k,) fleet index of the robot holding each task at ``t_s`` (s), -1 for none.
+
+        A task released is held by no one until another robot claims it.
+        """
+        holder: IntArray = np.full(len(self.xy), -1, dtype=np.int64)
+        now = (self.hold_from <= t_s) & (t_s < self.hold_to)
+        holder[self.hold_task[now]] = self.hold_robot[now]
+        return holder
 
 
 class FleetLayer:
@@ -165,23 +182,29 @@ class FleetLayer:
     def _show_tasks(self, t_s: float, x: FloatArray, y: FloatArray) -> None:
         tasks = self.tasks
         shown = tasks.open_at(t_s)
-        held = tasks.held_at(t_s) & shown
-        faces = [
-            self.colors[h] if is_held else WAITING_COLOR
-            for h, is_held in zip(tasks.holder[shown], held[shown], strict=True)
-        ]
-        self.stations.set_offsets(tasks.xy[shown] if shown.any() else np.zeros((0, 2)))
+        holder = tasks.holders_at(t_s)
+        held = (holder >= 0) & shown
+        # waiting tasks first: a held task at a shared station is drawn over them
+        order = np.flatnonzero(shown)
+        order = order[np.argsort(holder[order] >= 0, kind="stable")]
+        faces = [self.colors[h] if h >= 0 else WAITING_COLOR for h in holder[order]]
+        self.stations.set_offsets(tasks.xy[order] if len(order) else np.zeros((0, 2)))
         self.stations.set_facecolor(faces if faces else "none")
-        holders = tasks.holder[held]
+        holders = holder[held]
         robots = np.column_stack([x[holders], y[holders]])
         self.links.set_segments(list(np.stack([robots, tasks.xy[held]], axis=1)))
         self.links.set_colors([self.colors[h] for h in holders] if len(holders) else "none")
 
 
+def robot_label(run: RunData, robot: str) -> str:
+    """A robot's name for legends, ``(physical)`` added for a physical robot's twin."""
+    return f"{robot} (physical)" if robot in run.scenario.physical.robots else robot
+
+
 def fleet_handles(run: RunData, colors: list[Color]) -> list[Line2D]:
     """Legend entries: a robot per colour (one entry for large fleets), the task markers."""
     handles = [
-        Line2D([], [], color=c, marker="o", markeredgecolor="0.1", label=name)
+        Line2D([], [], color=c, marker="o", markeredgecolor="0.1", label=robot_label(run, name))
         for name, c in zip(run.track.robots, colors, strict=True)
     ]
     if len(handles) > LEGEND_ROBOTS_MAX:

@@ -11,7 +11,7 @@ from matplotlib.patches import Rectangle
 
 from adapters.world.files import read_map
 from cosim.core.errors import ExportError
-from cosim.plotting.canvas import save_png
+from cosim.plotting.canvas import run_colors, save_png
 from cosim.plotting.rundata import RunData
 
 PANELS_PER_ROW = 3
@@ -72,6 +72,7 @@ def quality_figure(run: RunData, png_path: Path) -> Path | None:
     table = pd.read_parquet(path)
     if table.empty:
         return None
+    colors = dict(zip(run.track.robots, run_colors(run), strict=True))
     figure = Figure(figsize=(12.0, 3.6), layout="constrained")
     axes = figure.subplots(1, 3)
     for ax, column, unit in zip(
@@ -79,13 +80,14 @@ def quality_figure(run: RunData, png_path: Path) -> Path | None:
     ):
         for robot, rows in table.groupby("robot", observed=True, sort=False):
             fleet = robot == "fleet"
+            color = "k" if fleet else colors.get(str(robot), "0.5")
             ax.plot(
-                rows.t_s, rows[column], lw=2.2 if fleet else 0.8, color="k" if fleet else None,
+                rows.t_s, rows[column], lw=2.2 if fleet else 0.8, color=color,
                 alpha=1.0 if fleet else 0.6, label="fleet" if fleet else None,
             )  # fmt: skip
         if column == "ate_m":
             fleet_rows = table[table.robot == "fleet"]
-            ax.plot(fleet_rows.t_s, fleet_rows.ate_odom_m, color="#d62728", ls="--",
+            ax.plot(fleet_rows.t_s, fleet_rows.ate_odom_m, color="0.35", ls="--",
                     label="odometry alone (fleet)")  # fmt: skip
         ax.set_xlabel("time (s)")
         ax.set_ylabel(f"{column} ({unit})")

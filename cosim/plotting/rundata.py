@@ -18,6 +18,7 @@ import pandas as pd
 from adapters.world.warehouse import scenario_warehouse
 from cosim.core.errors import ExportError
 from cosim.plotting.canvas import robot_order
+from cosim.plotting.ownership import task_holds
 from cosim.scenario import Scenario, load_scenario
 from models.arrays import FloatArray
 from models.world import Warehouse
@@ -39,9 +40,19 @@ MESSAGE_COLUMNS = ("t_sent_s", "t_recv_s", "src_host", "dst_host", "topic", "sta
 ASSIGNMENT_COLUMNS = ("epoch", "t_s", "robot", "round", "converged", "messages")
 NAVIGATION_COLUMNS = ("t_s", "robot", "event", "goal_x_m", "goal_y_m")
 HUMAN_COLUMNS = ("t_s", "id", "kind", "x_m", "y_m", "yaw_rad")
-STATION_TOLERANCE_M = 1e-6
-"""A navigation goal this close to a task station is a goal to that station (m)."""
-_NAMES = ("robot", "src_host", "dst_host", "topic", "status", "event", "id", "kind")
+EVENT_COLUMNS = ("t_s", "source", "kind", "detail")
+_NAMES = (
+    "robot",
+    "src_host",
+    "dst_host",
+    "topic",
+    "status",
+    "event",
+    "id",
+    "kind",
+    "source",
+    "detail",
+)
 """Columns of names (categorical in the tables), read as plain strings."""
 
 
@@ -85,12 +96,16 @@ class RunData:
         warehouse: the run's world, rebuilt from the scenario (frame ``map``, m).
         track: the poses.
         tasks: ``tables/tasks`` (names as ``str``, ``""`` for no robot) plus ``holder``:
-            the robot that served the task, else (claimed, not yet served when the run
-            ended) the robot navigation sent to its station nearest the claim time, else
-            ``""``; None when the run has no such table or it has no row.
+            the robot of its last holding (see ``holds``), ``""`` if none or if that robot
+            released it; None when the run has no such table or it has no row.
         messages: ``tables/messages``, or None likewise.
         assignments: ``tables/assignments``, or None likewise.
         humans: ``tables/humans`` (people and forklifts moved by SUMO), or None likewise.
+        holds: who held which task when (see :func:`cosim.plotting.ownership.task_holds`):
+            a row per holding, ``task``, ``robot``, ``t_from_s``, ``t_to_s`` (NaN: still
+            held at the end), ``end`` (``completed``, ``released`` or ``open``); None
+            without tasks.
+        navigation: ``tables/navigation`` (goals sent, arrivals), or None likewise.
     """
 
     path: Path
@@ -101,6 +116,8 @@ class RunData:
     messages: pd.DataFrame | None
     assignments: pd.DataFrame | None
     humans: pd.DataFrame | None = None
+    holds: pd.DataFrame | None = None
+    navigation: pd.DataFrame | None = None
 
     @property
     def title(self) -> str:
@@ -129,46 +146,32 @@ def load_run(run_dir: Path) -> RunData:
     poses = _read(poses_path, "poses", POSE_COLUMNS)
     if poses.empty:
         raise ExportError(f"{poses_path}: no pose; expected the poses of at least one robot")
+    tasks = _optional(run_dir, "tasks", TASK_COLUMNS)
+    navigation = _optional(run_dir, "navigation", NAVIGATION_COLUMNS)
+    events = _optional(run_dir, "events", EVENT_COLUMNS)
+    holds = None if tasks is None else task_holds(tasks, navigation, events)
     return RunData(
         path=run_dir,
         scenario=scenario,
         warehouse=scenario_warehouse(scenario),
         track=_track(poses, poses_path),
-        tasks=_tasks(run_dir),
+        tasks=_with_holder(tasks, holds),
         messages=_optional(run_dir, "messages", MESSAGE_COLUMNS),
         assignments=_optional(run_dir, "assignments", ASSIGNMENT_COLUMNS),
         humans=_optional(run_dir, "humans", HUMAN_COLUMNS),
+        holds=holds,
+        navigation=navigation,
     )
 
 
-def _tasks(run_dir: Path) -> pd.DataFrame | None:
-    """The tasks table with a ``holder`` column (see :class:`RunData`), or None.
-
-    The tasks table names a robot only once the task source granted it the service; a
-    robot that claimed a task and was still driving to it when the run ended shows in the
-    navigation table as a goal sent to the task's station around the claim time.
-    """
-    tasks = _optional(run_dir, "tasks", TASK_COLUMNS)
-    if tasks is None:
-        return None
-    holders = [str(r) for r in tasks["robot"]]
-    navigation = _optional(run_dir, "navigation", NAVIGATION_COLUMNS)
-    if navigation is None:
-        return tasks.assign(holder=holders)
-    goals = navigation[navigation["event"] == "goal"]
-    gx, gy, gt = (goals[c].to_numpy(np.float64) for c in ("goal_x_m", "goal_y_m", "t_s"))
-    sent_to = [str(r) for r in goals["robot"]]
-    xs, ys, created, assigned = (
-        tasks[c].to_numpy(np.float64) for c in ("x_m", "y_m", "t_created_s", "t_assigned_s")
-    )
-    for k, holder in enumerate(holders):
-        if holder or not np.isfinite(assigned[k]):
-            continue
-        near = np.abs(gx - xs[k]) + np.abs(gy - ys[k]) <= STATION_TOLERANCE_M
-        (sent,) = np.nonzero(near & (gt >= created[k]))
-        if len(sent):
-            holders[k] = sent_to[sent[np.argmin(np.abs(gt[sent] - assigned[k]))]]
-    return tasks.assign(holder=holders)
+def _with_holder(tasks: pd.DataFrame | None, holds: pd.DataFrame | None) -> pd.DataFrame | None:
+    """The tasks table plus ``holder``: its last holding's robot unless that one released it."""
+    if tasks is None or holds is None:
+        return tasks
+    last = holds.groupby("task", sort=False).last()
+    kept = last[last["end"] != "released"]["robot"]
+    holder = dict(zip(kept.index.astype(float), kept.astype(str), strict=True))
+    return tasks.assign(holder=[holder.get(float(k), "") for k in tasks["task"]])
 
 
 def _optional(run_dir: Path, name: str, columns: tuple[str, ...]) -> pd.DataFrame | None:

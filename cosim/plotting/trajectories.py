@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -13,6 +14,7 @@ from matplotlib.lines import Line2D
 
 from cosim.plotting.canvas import LEGEND_ROBOTS_MAX, Color, fleet_colors, save_png
 from cosim.plotting.fleet import TRAIL_S, WAITING_COLOR, FleetLayer, TaskTimes, fleet_handles
+from cosim.plotting.goals import GoalLayer, draw_goals, goal_handles
 from cosim.plotting.people import PeopleLayer, draw_tracks, people_handles
 from cosim.plotting.rundata import RunData
 from cosim.plotting.world import SHELF_MUTED, draw_world, world_handles, world_inches
@@ -31,9 +33,11 @@ def trajectories_figure(run: RunData, png_path: Path) -> Path:
     """Draw every robot's trajectory over the world to ``png_path``.
 
     A colour per robot, its start as a square, its final pose as a disc with a heading tick
-    (frame ``map``, m); people and forklifts as thin tracks and at their final place; with
-    tasks, every task station as a diamond filled with the colour
-    of the robot that completed it (white: not completed), labelled with its task numbers.
+    (frame ``map``, m); in a run without tasks, every goal sent (stars, numbered in the order
+    sent); people and forklifts as thin tracks and at their final place; with
+    tasks, every task station once, as a diamond filled with the colour of the robot that
+    completed its last completed task (white: none of its tasks completed), labelled with
+    its task numbers (those not completed in parentheses).
 
     Raises:
         ExportError: naming the path if the file cannot be written.
@@ -55,12 +59,14 @@ def trajectories_figure(run: RunData, png_path: Path) -> Path:
     FleetLayer(ax, run, colors, trail_s=0.0, tasks=False).show(len(track.t_s) - 1)
     PeopleLayer(ax, run).show(float(track.t_s[-1]))
     _stations(ax, run, colors)
+    draw_goals(ax, run, colors)
     ax.set_title(
         f"{run.title}: trajectories, t = {track.t_s[0]:g} to {track.t_s[-1]:g} s", fontsize=10
     )
     handles = [
         *_robot_lines(run, colors),
         *_marks(run),
+        *goal_handles(run),
         *people_handles(run),
         *world_handles(run.warehouse, shelf_color=SHELF_MUTED),
     ]
@@ -73,8 +79,9 @@ def snapshots_figure(run: RunData, times_s: Sequence[float], png_path: Path) -> 
 
     Each panel: the world, every robot as a disc with a heading tick at the pose sample
     nearest the time, its trail over the last :data:`~cosim.plotting.fleet.TRAIL_S`, and the
-    open tasks (filled with the holder's colour, a dashed line to it), and the people and
-    forklifts at that time. Panels wrap after 3
+    open tasks (filled with the colour of the robot holding it then, a dashed line to it;
+    white: released or not yet claimed), each robot's current goal in a run without tasks
+    (a star, a dotted line to it), and the people and forklifts at that time. Panels wrap after 3
     (2 for 4 times); times are expected within the run (checked by the caller).
 
     Raises:
@@ -97,7 +104,9 @@ def snapshots_figure(run: RunData, times_s: Sequence[float], png_path: Path) -> 
     for k, (ax, t) in enumerate(zip(panels, times_s, strict=False)):
         draw_world(ax, run.warehouse, shelf_color=SHELF_MUTED, labels=False)
         i = track.index_at(t)
-        FleetLayer(ax, run, colors).show(i)
+        fleet = FleetLayer(ax, run, colors)
+        fleet.show(i)
+        GoalLayer(ax, run, colors).show(float(track.t_s[i]), track.x_m[i], track.y_m[i])
         PeopleLayer(ax, run).show(float(track.t_s[i]))
         ax.set_title(f"t = {track.t_s[i]:.1f} s", fontsize=10)
         if k % cols == 0:
@@ -108,6 +117,7 @@ def snapshots_figure(run: RunData, times_s: Sequence[float], png_path: Path) -> 
     figure.suptitle(f"{run.title}: snapshots, trails of the last {TRAIL_S:g} s", fontsize=11)
     handles = [
         *fleet_handles(run, colors),
+        *goal_handles(run),
         *people_handles(run),
         *world_handles(run.warehouse, shelf_color=SHELF_MUTED),
     ]
@@ -151,7 +161,7 @@ def _marks(run: RunData) -> list[Line2D]:
                 marker="D",
                 mec="0.15",
                 lw=0,
-                label="task station, done (robot's colour)",
+                label="task station: robot that did its last task",
             ),
             Line2D(
                 [],
@@ -160,41 +170,70 @@ def _marks(run: RunData) -> list[Line2D]:
                 marker="D",
                 mec="0.15",
                 lw=0,
-                label="task station, not done",
+                label="task station, none done; (n): task n not done",
             ),
         ]
     return marks
 
 
 def _stations(ax: Axes, run: RunData, colors: list[Color]) -> None:
-    """Every task station, filled with the colour of the robot that completed its last task."""
+    """Every task station once, filled and labelled as :func:`station_summary` says.
+
+    Filled with the colour of the robot that completed its last completed task (white:
+    none of its tasks completed).
+    """
     tasks = TaskTimes.of(run)
-    if not len(tasks.xy):
+    if not len(tasks.xy) or run.tasks is None:
         return
-    done = np.isfinite(tasks.completed) & (tasks.holder >= 0)
-    faces = [colors[h] if d else WAITING_COLOR for h, d in zip(tasks.holder, done, strict=True)]
+    stations = station_summary(tasks, [f"{k:g}" for k in run.tasks["task"]])
+    faces = [colors[s.robot] if s.robot >= 0 else WAITING_COLOR for s in stations]
+    xy = np.array([s.xy for s in stations])
     ax.scatter(
-        x=tasks.xy[:, 0],
-        y=tasks.xy[:, 1],
-        s=36,
-        marker="D",
-        c=faces,
-        edgecolors="0.15",
-        linewidths=0.7,
+        x=xy[:, 0], y=xy[:, 1], s=36, marker="D", c=faces, edgecolors="0.15", linewidths=0.7,
         zorder=4,
-    )
-    if len(tasks.xy) > TASK_IDS_MAX or run.tasks is None:
+    )  # fmt: skip
+    if len(tasks.xy) > TASK_IDS_MAX:
         return
-    ids: dict[tuple[float, float], list[str]] = {}
-    for (x, y), task in zip(tasks.xy, run.tasks["task"], strict=True):
-        ids.setdefault((round(float(x), 2), round(float(y), 2)), []).append(f"{task:g}")
-    for (x, y), names in ids.items():
+    for station in stations:
         ax.annotate(
-            ",".join(names),
-            (x, y),
+            station.label,
+            station.xy,
             xytext=(4, 3),
             textcoords="offset points",
             fontsize=6,
             color="0.15",
             zorder=7,
         )
+
+
+@dataclass(frozen=True)
+class Station:
+    """A task station and its tasks over a run.
+
+    Attributes:
+        xy: the station (m, ``map``).
+        robot: fleet index of the robot that completed its last completed task, -1: none.
+        done: tasks completed there.
+        label: its task numbers in creation order, those not completed in parentheses.
+    """
+
+    xy: tuple[float, float]
+    robot: int
+    done: int
+    label: str
+
+
+def station_summary(tasks: TaskTimes, names: list[str]) -> list[Station]:
+    """The stations of ``tasks`` (``names``: each task's number as text), in first use order."""
+    rows: dict[tuple[float, float], list[int]] = {}
+    for k, (x, y) in enumerate(tasks.xy):
+        rows.setdefault((round(float(x), 3), round(float(y), 3)), []).append(k)
+    stations = []
+    for ks in rows.values():
+        done = [k for k in ks if np.isfinite(tasks.completed[k])]
+        last = max(done, key=lambda k: float(tasks.completed[k])) if done else -1
+        robot = int(tasks.served_by[last]) if done else -1
+        label = ",".join(names[k] if k in done else f"({names[k]})" for k in ks)
+        x, y = tasks.xy[ks[0]]
+        stations.append(Station((float(x), float(y)), robot, len(done), label))
+    return stations

@@ -23,6 +23,7 @@ from cosim.core.timebase import NS_PER_S, s_to_ns
 from cosim.recording.foxglove import LiveOptions
 from cosim.recording.setup import RecordingPlan, RecordingSession
 from cosim.runner.assembly import Assembly, assemble
+from cosim.runner.compiletime import CompileClock
 from cosim.runner.outfolder import prepare_out, write_run
 from cosim.runner.stopping import CHECK_EVERY_S, RunStopped, StopRequest, signal_name
 from cosim.scenario.model import Scenario
@@ -51,6 +52,9 @@ class RunResult:
             summary then says ``"stopped"`` and the simulated time reached).
         failure: the error of an external system that ended the run early (a robot or a
             motion-capture server gone silent), or None; the summary then says ``"failed"``.
+        compile_time_s: wall-clock seconds numba spent compiling kernels for this run (s;
+            about 13 s on a machine's first run, 0 once they are cached); the summary's
+            ``wall_time_s`` and ``real_time_factor`` leave it out.
     """
 
     scenario: Scenario
@@ -64,6 +68,7 @@ class RunResult:
     files: dict[str, bytes] = field(default_factory=dict, repr=False)
     stopped: int | None = None
     failure: CosimError | None = field(default=None, repr=False)
+    compile_time_s: float = 0.0
 
     def deterministic_tables(self) -> dict[str, pd.DataFrame]:
         """The tables without their wall-clock columns: equal for equal scenario and seed."""
@@ -90,6 +95,7 @@ def execute(
     on_ready: Callable[[RecordingSession], None] | None = None,
     adapters: Sequence[str | AdapterType] = (),
     stop: StopRequest | None = None,
+    figures: bool = False,
 ) -> RunResult:
     """Run a scenario to its duration and return its result.
 
@@ -114,43 +120,54 @@ def execute(
             kernel runs, a stop asked for ends the run at an event boundary and the result
             covers the simulated time reached (``stopped``); before, it raises
             :class:`~cosim.runner.stopping.RunStopped` at once.
+        figures: the caller draws this run's figures into ``out/figures`` afterwards
+            (``cosim run --figures``), so ``force`` removes an earlier run's figures too;
+            without it they stay (drawn by ``cosim plot``, they are not this run's to remove).
 
     Raises:
         BridgeError: an external system failed while the kernel ran (a physical robot or a
             motion-capture server gone silent); the bag is finished and the error's
             ``kept`` holds the result of the simulated time reached.
     """
-    with _immediate(stop):
-        plan = RecordingPlan.for_run(scenario, out, live)
-        registry, extra = with_adapters(registry or AdapterRegistry.from_entry_points(), adapters)
-        assembly = assemble(
-            scenario,
-            names=names,
-            registry=registry,
-            extra=extra,
-            realtime=live is not None,
-            speed=live.rate if live is not None else 1.0,
-            recording=plan.active,
-        )
-        run = assembly.run
-        topics = RecordingSession.topics_of(scenario, run.bus) if plan.active else {}
-        session = RecordingSession(plan, topics, run.bus)
-    folder = Path(out) if out is not None else None
-    bag = plan.bag is not None
-    prepare = None if folder is None else lambda: prepare_out(folder, force=force, bag=bag)
-    try:
+    with CompileClock() as clock:  # numba's compile time, said apart from the speed
         with _immediate(stop):
-            if plan.active:
-                session.open(before_bag=prepare)
-            elif prepare is not None:
-                prepare()
-            if on_ready is not None:
-                on_ready(session)
-        with _deferred(stop):
-            result = _run_assembled(scenario, assembly, progress, stop)
-    finally:
-        with _deferred(stop):  # the bag is finished (metadata.yaml) whatever stopped the run
-            session.close()
+            plan = RecordingPlan.for_run(scenario, out, live)
+            registry, extra = with_adapters(
+                registry or AdapterRegistry.from_entry_points(), adapters
+            )
+            assembly = assemble(
+                scenario,
+                names=names,
+                registry=registry,
+                extra=extra,
+                realtime=live is not None,
+                speed=live.rate if live is not None else 1.0,
+                recording=plan.active,
+            )
+            run = assembly.run
+            topics = RecordingSession.topics_of(scenario, run.bus) if plan.active else {}
+            session = RecordingSession(plan, topics, run.bus)
+        folder = Path(out) if out is not None else None
+        bag = plan.bag is not None
+        prepare = (
+            None
+            if folder is None
+            else lambda: prepare_out(folder, force=force, bag=bag, figures=figures)
+        )
+        try:
+            with _immediate(stop):
+                if plan.active:
+                    session.open(before_bag=prepare)
+                elif prepare is not None:
+                    prepare()
+                if on_ready is not None:
+                    on_ready(session)
+            with _deferred(stop):
+                result = _run_assembled(scenario, assembly, progress, stop, clock)
+        finally:
+            with _deferred(stop):  # the bag is finished (metadata.yaml) whatever stopped the run
+                session.close()
+    result.compile_time_s = round(clock.seconds, 3)
     result.bag = plan.bag
     result.recorded = session.counts()
     if result.failure is not None:
@@ -201,11 +218,13 @@ def _run_assembled(
     assembly: Assembly,
     progress: ProgressFn | None,
     stop: StopRequest | None = None,
+    clock: CompileClock | None = None,
 ) -> RunResult:
     run = assembly.run
     duration_s = scenario.scenario.duration_s
     until_ns = s_to_ns(duration_s)
     wall_start = time.perf_counter()
+    compiled_before_s = clock.seconds if clock is not None else 0.0
     for _name, adapter in assembly.adapters:
         adapter.start(run)
     done = [0]  # events processed when the last check ran
@@ -239,7 +258,9 @@ def _run_assembled(
             close = getattr(adapter, "close", None)
             if close is not None:
                 close()
-    wall_s = time.perf_counter() - wall_start
+    # the run loop's own time: the first run on a machine compiles numba's kernels in it
+    compiling_s = clock.seconds - compiled_before_s if clock is not None else 0.0
+    wall_s = max(time.perf_counter() - wall_start - compiling_s, 0.0)
     reached_s = run.kernel.now_ns / NS_PER_S if halted else duration_s
     counts = run.recorder.counts
     sent = sum(counts.values())
@@ -332,6 +353,7 @@ def run(
     on_ready: Callable[[RecordingSession], None] | None = None,
     adapters: Sequence[str | AdapterType] = (),
     stop: StopRequest | None = None,
+    figures: bool = False,
 ) -> RunResult:
     """Run a scenario; optionally write its folder.
 
@@ -358,9 +380,13 @@ def run(
             to stop ends at an event boundary, and what ran is kept (the bag finished, the
             tables and a summary marked ``"stopped"`` written) before
             :class:`~cosim.runner.stopping.RunStopped` is raised with the result.
+        figures: the caller draws the run's figures into ``out/figures`` afterwards, so
+            ``force`` removes an earlier run's figures; without it, ``force`` keeps them.
 
     Returns:
-        The run's summary and tables.
+        The run's summary and tables (``summary["wall_time_s"]`` and
+        ``["real_time_factor"]`` of the run loop without numba's compiling, which is in
+        ``compile_time_s``).
 
     Raises:
         RunStopped: the run was asked to stop (``stop``).
@@ -383,6 +409,7 @@ def run(
                 on_ready=on_ready,
                 adapters=adapters,
                 stop=stop,
+                figures=figures,
             )
         except BridgeError as error:
             if error.kept is None or folder is None:

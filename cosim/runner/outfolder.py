@@ -2,11 +2,15 @@
 
 A run writes ``summary.json``, ``scenario.toml``, ``tables/NAME.parquet`` (one per table),
 ``bag/`` (``metadata.yaml`` and ``bag.mcap`` or ``bag.db3``), ``maps/NAME.yaml`` + ``.pgm``
-(``fleet`` and ``robot_N``), SUMO's files in ``sumo/`` and, drawn afterwards,
-``figures/``. ``--force`` removes exactly those of an earlier run and leaves every other
-file where it is; a file in the way of the new results (a stranger in ``bag/``, which
-rosbags must create afresh; a folder named ``summary.json``) is named in one line instead
-of being deleted.
+(``fleet`` and ``robot_N``), SUMO's files in ``sumo/`` and, drawn afterwards with
+``--figures``/``--gif``, ``figures/``. ``--force`` removes exactly those of an earlier run
+that this run writes again (the figures only when it draws them: figures made with
+``cosim plot`` stay otherwise) and leaves every other file where it is; a file in the way of
+the new results (a stranger in ``bag/``, which rosbags must create afresh; a folder named
+``summary.json``) is named in one line instead of being deleted.
+
+A run without ``--out`` writes to ``runs/NAME-seedN``, or, when that folder holds results
+already, to the first free ``runs/NAME-seedN-2``, ``-3``, ... (:func:`default_out`).
 """
 
 from __future__ import annotations
@@ -65,8 +69,45 @@ def table_names() -> set[str]:
     return names
 
 
-def _earlier_results(out: Path) -> Iterator[Path]:
-    """The files of an earlier run in ``out`` (what a run writes there, nothing else)."""
+LAST = 1000
+"""One past the last number :func:`default_out` tries (``runs/NAME-seedN-999``)."""
+
+
+def default_out(base: Path) -> Path:
+    """The folder a run without ``--out`` writes to: ``base``, or the first free numbered one.
+
+    ``base`` (``runs/NAME-seedN``) when it does not exist or is an empty folder, else the
+    first of ``base-2``, ``base-3``, ... that does not exist (made here, so that two runs
+    started together do not take the same one).
+
+    Raises:
+        ExportError: the file system refuses to make the folder.
+    """
+    candidates = (base if n == 1 else base.with_name(f"{base.name}-{n}") for n in range(1, LAST))
+    try:
+        for folder in candidates:
+            if folder.is_dir() and not any(folder.iterdir()):
+                return folder
+            try:
+                folder.mkdir(parents=True)
+            except FileExistsError:
+                continue
+            return folder
+    except OSError as error:
+        raise ExportError(f"{base}: cannot make the results folder ({_reason(error)})") from None
+    raise ExportError(
+        f"{base}: it and {base.name}-2 to {base.name}-{LAST - 1} all exist; "
+        "choose a folder with --out"
+    )
+
+
+def _earlier_results(out: Path, *, figures: bool = True) -> Iterator[Path]:
+    """The files of an earlier run in ``out`` that this run writes again, nothing else.
+
+    Args:
+        out: the run folder.
+        figures: the run draws its figures (``--figures``): the earlier ones go too.
+    """
     for name in TOP_FILES:
         if (out / name).is_file():
             yield out / name
@@ -80,16 +121,20 @@ def _earlier_results(out: Path) -> Iterator[Path]:
         ("figures", FIGURE_FILES.__contains__),
         ("sumo", SUMO_FILE.fullmatch),
     ):
+        if folder == "figures" and not figures:
+            continue
         if (out / folder).is_dir():
             yield from (p for p in (out / folder).iterdir() if p.is_file() and written(p.name))
 
 
-def _in_the_way(out: Path, doomed: set[Path], *, bag: bool) -> str | None:
+def _in_the_way(out: Path, doomed: set[Path], *, bag: bool, figures: bool) -> str | None:
     """What in ``out`` would keep a run from writing its results, said in one line."""
     for name in TOP_FILES:
         if (out / name).exists() and not (out / name).is_file():
             return f"{out / name}: is a folder where a run writes its {name}"
     for name in FOLDERS:
+        if name == "figures" and not figures:
+            continue
         if (out / name).exists() and not (out / name).is_dir():
             return f"{out / name}: is a file where a run writes its {name}/ folder"
     if bag and (out / BAG_DIR).is_dir():
@@ -103,13 +148,16 @@ def _in_the_way(out: Path, doomed: set[Path], *, bag: bool) -> str | None:
     return None
 
 
-def prepare_out(out: Path, *, force: bool, bag: bool = True) -> None:
+def prepare_out(out: Path, *, force: bool, bag: bool = True, figures: bool = False) -> None:
     """Make sure ``out`` can take a run's results (made if new); ``force`` clears an earlier run.
 
     Args:
         out: the run folder.
-        force: remove the files an earlier run wrote there (nothing else).
+        force: remove the files an earlier run wrote there that this run writes again
+            (nothing else).
         bag: the run writes a bag (``bag/`` must then hold nothing but an earlier bag).
+        figures: the run's figures are drawn into ``out/figures`` after it (``--figures``):
+            ``force`` then removes the earlier figures; without it ``figures/`` stays as is.
 
     Raises:
         ExportError: ``out`` is a file, or a non-empty folder and ``force`` is false, or a
@@ -126,8 +174,8 @@ def prepare_out(out: Path, *, force: bool, bag: bool = True) -> None:
             return
         if not force:
             raise ExportError(f"{out}: folder is not empty; not overwriting (use --force)")
-        doomed = set(_earlier_results(out))
-        problem = _in_the_way(out, doomed, bag=bag)
+        doomed = set(_earlier_results(out, figures=figures))
+        problem = _in_the_way(out, doomed, bag=bag, figures=figures)
         if problem is not None:
             raise ExportError(f"{problem}; move it away or choose another --out")
         for path in sorted(doomed):

@@ -13,23 +13,33 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from matplotlib.axes import Axes
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
-from scipy import stats as scipy_stats
 
 from cosim.core.errors import ConfigError, ExportError
+from cosim.studies.intervals import POINTS_UP_TO, band_caption, bootstrap_interval, y_limits
+from cosim.studies.labels import axis_label, short_label
+from cosim.studies.panels import PANELS_PER_ROW
+from cosim.studies.panels import caption as _caption
+from cosim.studies.panels import label_axes as _label_axes
+from cosim.studies.panels import levels as _levels
+from cosim.studies.panels import panels as _panels
+from cosim.studies.panels import save_figure as save_figure
+from cosim.studies.panels import value_label as _label
 
 RESULTS_FILE = "results.parquet"
 REPORT_FILE = "report.md"
 FIGURES_DIR = "figures"
 ERRORS_LISTED = 5  # failed runs quoted in a report; the others are only counted
-DPI = 150
 MARKERS = "osD^v<>pPXh*"
-PANELS_PER_ROW = 3
-"""Facet panels per row of a figure; more values wrap onto further rows."""
 _BAND = ("mean", "ci_low", "ci_high")
+DRAWN = ("n", "mean", "low", "high")
+"""Columns of the ``<figure>.csv`` beside each figure, after the group columns."""
+INTERVAL_NOTE = (
+    "Each cell: mean over the ok runs and, in brackets, the 95 % percentile bootstrap interval "
+    "of the mean (2,000 resamples of the runs, seeded), which stays within the runs' range; "
+    "the figures draw the same interval."
+)
 
 
 def load_results(study_dir: str | Path) -> pd.DataFrame:
@@ -57,14 +67,17 @@ def load_results(study_dir: str | Path) -> pd.DataFrame:
 def aggregate(
     results: pd.DataFrame, by: Sequence[str], metrics: Sequence[str], *, confidence: float = 0.95
 ) -> pd.DataFrame:
-    """Mean, standard deviation and Student t ``confidence`` interval of metrics per group.
+    """Mean, standard deviation and bootstrap ``confidence`` interval of metrics per group.
 
-    Only ok runs count; NaN values are dropped per metric; booleans count as 0/1.
+    The interval is :func:`cosim.studies.intervals.bootstrap_interval` (percentile bootstrap
+    of the mean, seeded): it never leaves the range of the group's runs. Only ok runs count;
+    NaN values are dropped per metric; booleans count as 0/1.
 
     Returns:
         A row per group (one for ``by=[]``), ordered by each ``by`` column in turn (numbers
         ascending, others as they appear): ``by``, then ``{m}_mean``, ``{m}_std``, ``{m}_n``,
-        ``{m}_ci_low``, ``{m}_ci_high`` per metric ``m``, in its unit; n=1: std NaN, no width.
+        ``{m}_ci_low``, ``{m}_ci_high`` per metric ``m``, in its unit; n=1 or equal values: no
+        width (n=1: std NaN).
 
     Raises:
         ConfigError: a missing column, a non-numeric metric, or ``confidence`` not in (0, 1).
@@ -80,11 +93,11 @@ def aggregate(
     mean, std, count = grouped.mean(), grouped.std(), grouped.count()
     out = pd.DataFrame(index=mean.index)
     for m in names:
-        n = count[m].to_numpy(dtype=int)
-        t = scipy_stats.t.ppf((1.0 + confidence) / 2.0, np.maximum(n - 1, 1))
-        half = np.where(n >= 2, t * std[m].to_numpy(float) / np.sqrt(np.maximum(n, 1)), 0.0)
-        out[f"{m}_mean"], out[f"{m}_std"], out[f"{m}_n"] = mean[m], std[m], n
-        out[f"{m}_ci_low"], out[f"{m}_ci_high"] = mean[m] - half, mean[m] + half
+        band = grouped[m].apply(lambda s: bootstrap_interval(s, confidence=confidence))
+        band = band.reindex(mean.index)
+        out[f"{m}_mean"], out[f"{m}_std"], out[f"{m}_n"] = mean[m], std[m], count[m].astype(int)
+        out[f"{m}_ci_low"] = [b[0] if isinstance(b, tuple) else np.nan for b in band]
+        out[f"{m}_ci_high"] = [b[1] if isinstance(b, tuple) else np.nan for b in band]
     out = out.reset_index(drop=not keys)
     for k in keys:  # back from the ordered categories of _ordered
         out[k] = out[k].astype(ok[k].dtype)
@@ -103,12 +116,36 @@ def metric_figure(
     logx: bool = False,
 ) -> Figure:
     """The figure of :func:`plot_metric`, unsaved (to inspect its axes)."""
+    return metric_figure_data(
+        results, x, metric, hue=hue, facet=facet, title=title, confidence=confidence, logx=logx
+    )[0]
+
+
+def metric_figure_data(
+    results: pd.DataFrame,
+    x: str,
+    metric: str,
+    *,
+    hue: str | None = None,
+    facet: str | None = None,
+    title: str | None = None,
+    confidence: float = 0.95,
+    logx: bool = False,
+) -> tuple[Figure, pd.DataFrame]:
+    """The figure of :func:`plot_metric` and what it draws (group columns, n, mean, low, high).
+
+    Each group's mean with its bootstrap band (:func:`aggregate`); when no group has more
+    than :data:`~cosim.studies.intervals.POINTS_UP_TO` runs, each run's value as a small dot.
+    """
     stats, ok = _plot_stats(results, [facet, hue, x], metric, confidence)
     numeric_x = pd.api.types.is_numeric_dtype(ok[x]) and not pd.api.types.is_bool_dtype(ok[x])
     if logx and not numeric_x:
         raise ConfigError(f"logx: x column {x!r} holds {ok[x].dtype} values, expected numbers")
     x_levels, hues = _levels(ok[x]), _levels(ok[hue]) if hue else [None]
     facets, figure, axes = _panels(stats, facet, width_in=4.8)
+    runs = ok.assign(_value=pd.to_numeric(ok[metric], errors="coerce")).dropna(subset=["_value"])
+    dots = int(stats[f"{metric}_n"].max()) <= POINTS_UP_TO
+    drawn: list[np.ndarray] = []
     for ax, facet_value in zip(axes, facets, strict=True):
         panel = _where(stats, facet, facet_value)
         for i, hue_value in enumerate(hues):
@@ -117,14 +154,20 @@ def metric_figure(
             mean, low, high = (rows[f"{metric}_{s}"].to_numpy(float) for s in _BAND)
             color, marker = f"C{i % 10}", MARKERS[i % len(MARKERS)]
             label = _label(hue_value) if hue else None
+            points = _where(_where(runs, facet, facet_value), hue, hue_value)
+            drawn += [mean, low, high, points["_value"].to_numpy(float)]
+            offset = 0.5 * ((i + 0.5) / len(hues) - 0.5)
             if numeric_x:
-                xs = rows[x].to_numpy(float)
+                xs, run_xs = rows[x].to_numpy(float), points[x].to_numpy(float)
                 ax.plot(xs, mean, color=color, marker=marker, label=label)
                 ax.fill_between(xs, low, high, color=color, alpha=0.2, linewidth=0)
             else:  # no order to draw a line along: points, hue values side by side
-                xs = _positions(x_levels, rows[x]) + 0.5 * ((i + 0.5) / len(hues) - 0.5)
+                xs = _positions(x_levels, rows[x]) + offset
+                run_xs = _positions(x_levels, points[x]) + offset
                 yerr = np.vstack([mean - low, high - mean])
                 ax.errorbar(xs, mean, yerr, color=color, marker=marker, ls="none", label=label)
+            if dots:
+                ax.scatter(run_xs, points["_value"], s=9, color=color, alpha=0.45, linewidths=0)
         if not numeric_x:
             ax.set_xticks(range(len(x_levels)), [_label(v) for v in x_levels])
             ax.set_xlim(-0.5, len(x_levels) - 0.5)
@@ -132,13 +175,26 @@ def metric_figure(
             positive = ok[x][ok[x] > 0]
             ax.set_xscale("symlog", linthresh=float(positive.min()) if len(positive) else 1.0)
         ax.grid(True, alpha=0.3)
+    if (limits := y_limits(np.concatenate(drawn))) is not None:
+        axes[0].set_ylim(*limits)  # shared by every panel
+        for artist in (a for ax in axes for a in (*ax.lines, *ax.collections)):
+            artist.set_clip_on(False)  # a flat line on the axis stays whole
     _label_axes(axes, x, metric)
     if hue:  # beside the first row, where it covers no data
         axes[min(len(axes), PANELS_PER_ROW) - 1].legend(
-            title=hue, fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0)
+            title=short_label(hue), fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0)
         )
-    figure.suptitle(title or f"{metric} vs {x}")
-    return figure
+    title = title or f"{axis_label(metric)} vs {short_label(x)}"
+    _caption(figure, title, band_caption(stats[f"{metric}_n"].to_numpy(int)))
+    return figure, _drawn(stats, [facet, hue, x], metric)
+
+
+def _drawn(stats: pd.DataFrame, columns: Iterable[str | None], metric: str) -> pd.DataFrame:
+    """The group columns and n, mean, low, high of ``metric``: a figure's ``.csv``."""
+    keys = list(dict.fromkeys(c for c in columns if c is not None))
+    names = ("n", *_BAND)
+    table = stats[[*keys, *(f"{metric}_{s}" for s in names)]]
+    return table.set_axis([*keys, *DRAWN], axis=1).reset_index(drop=True)
 
 
 def plot_metric(
@@ -157,16 +213,17 @@ def plot_metric(
 
     Numeric ``x``: lines with markers and shaded ``confidence`` bands (``logx``: symlog).
     Other ``x``: categories in order of appearance, points with error bars. A series is one
-    ``Line2D``; ``facet`` gives a subplot per value; axes are labelled by the column names.
+    ``Line2D``; ``facet`` gives a subplot per value; axes are labelled in words and units
+    (:func:`cosim.studies.labels.axis_label`). What is drawn goes to ``out`` with ``.csv``.
 
     Raises:
         ConfigError: a column is missing, or ``logx`` with a categorical ``x``.
         ExportError: no ok run has a value of ``metric``, or ``out`` cannot be written.
     """
-    figure = metric_figure(
+    figure, drawn = metric_figure_data(
         results, x, metric, hue=hue, facet=facet, title=title, confidence=confidence, logx=logx
     )
-    return save_figure(figure, Path(out))
+    return save_figure(figure, Path(out), data=drawn)
 
 
 def heatmap(
@@ -181,7 +238,8 @@ def heatmap(
 ) -> Path:
     """Plot to ``out`` (PNG) the mean over ok runs of ``metric`` on an ``x`` by ``y`` grid.
 
-    Numbers ascending, each cell annotated; facets share one colour scale. Errors as for
+    Numbers ascending, each cell annotated; facets share one colour scale. What is drawn, with
+    the bootstrap interval of each cell, goes to ``out`` with ``.csv``. Errors as for
     :func:`plot_metric`.
     """
     stats, ok = _plot_stats(results, [facet, y, x], metric, 0.95)
@@ -202,9 +260,12 @@ def heatmap(
         ax.set_xticks(range(len(x_levels)), [_label(v) for v in x_levels])
         ax.set_yticks(range(len(y_levels)), [_label(v) for v in y_levels])
     _label_axes(axes, x, y)
-    figure.colorbar(image, ax=axes, label=f"{metric} (mean over seeds)")
-    figure.suptitle(title or f"{metric} over {x} and {y}")
-    return save_figure(figure, Path(out))
+    figure.colorbar(image, ax=axes, label=f"{axis_label(metric)}, mean")
+    n = stats[f"{metric}_n"].to_numpy(int)
+    note = f"cells: mean of n = {n.min()}" + (f"-{n.max()}" if n.max() > n.min() else "")
+    title = title or f"{axis_label(metric)} over {short_label(x)} and {short_label(y)}"
+    _caption(figure, title, note + " seeds; 95 % bootstrap intervals in the .csv")
+    return save_figure(figure, Path(out), data=_drawn(stats, [facet, y, x], metric))
 
 
 def markdown_table(frame: pd.DataFrame, floatfmt: str = ".3g") -> str:
@@ -255,9 +316,9 @@ def write_report(
 ) -> Path:
     """Write ``DIR/report.md`` for the study ``name`` and return its path.
 
-    Run counts, failed runs, per metric a table by (``facet``, ``hue``, ``x``) of mean ± 95 % CI
-    half-width, ``figures`` links (relative paths: to ``DIR``), notes on skipped metrics and
-    on parameters pooled over.
+    Run counts, failed runs, per metric a table by (``facet``, ``hue``, ``x``) of the mean and
+    its 95 % bootstrap interval (as the figures draw it), ``figures`` links (relative paths:
+    to ``DIR``), notes on skipped metrics and on parameters pooled over.
 
     Raises:
         ExportError: the results cannot be read or the report cannot be written.
@@ -297,7 +358,7 @@ def write_report(
 
 
 def _tables(ok: pd.DataFrame, by: list[str], metrics: Sequence[str]) -> list[str]:
-    lines = ["Each cell: mean ± half-width of the 95 % Student t interval over the ok runs.", ""]
+    lines = [INTERVAL_NOTE, ""]
     dotted = [str(c) for c in ok.columns if "." in str(c) and c not in by]
     if pooled := [f"`{c}`" for c in dotted if ok[c].nunique(dropna=False) > 1]:
         lines += [f"Runs are pooled over {', '.join(pooled)} (varied, not grouped by).", ""]
@@ -309,7 +370,7 @@ def _tables(ok: pd.DataFrame, by: list[str], metrics: Sequence[str]) -> list[str
         stats = aggregate(ok, by, [metric])
         table, n = stats[by].copy(), stats[f"{metric}_n"].to_numpy(int)
         mean, low, high = (stats[f"{metric}_{s}"].to_numpy(float) for s in _BAND)
-        cells = [f"{m:.3g} ± {(h - lo) / 2:.3g}" for m, lo, h in zip(mean, low, high, strict=True)]
+        cells = [f"{m:.3g} [{lo:.3g}, {h:.3g}]" for m, lo, h in zip(mean, low, high, strict=True)]
         table[metric] = np.where(n > 1, cells, np.where(n == 1, [f"{m:.3g}" for m in mean], "–"))
         table["n"] = n
         lines += [f"### {metric}", "", markdown_table(table), ""]
@@ -337,50 +398,6 @@ def _plot_stats(
     return stats, results[results["status"] == "ok"]
 
 
-def _panels(
-    stats: pd.DataFrame, facet: str | None, *, width_in: float
-) -> tuple[list[object], Figure, list[Axes]]:
-    """A panel per facet value, wrapped into rows of at most :data:`PANELS_PER_ROW`.
-
-    The panels share the y axis; unused cells of the last row are removed, so the axes
-    returned (in row-major order) are exactly one per facet value.
-    """
-    facets: list[object] = _levels(stats[facet]) if facet else [None]
-    cols = min(len(facets), PANELS_PER_ROW)
-    rows = -(-len(facets) // cols)
-    figure = Figure(figsize=(width_in * cols + 1.0, 3.8 * rows + 0.5), layout="constrained")
-    grid = figure.subplots(rows, cols, sharey=True, squeeze=False)
-    cells: list[Axes] = list(grid.flat)
-    for ax in cells[len(facets) :]:
-        figure.delaxes(ax)
-    axes = cells[: len(facets)]
-    for ax, value in zip(axes, facets, strict=True):
-        if facet:
-            ax.set_title(f"{facet} = {_label(value)}", fontsize=10)
-    return facets, figure, axes
-
-
-def _label_axes(axes: list[Axes], x: str, y: str) -> None:
-    """Label x under the panels with none below them, y left of each row of :func:`_panels`."""
-    cols = min(len(axes), PANELS_PER_ROW)
-    for k, ax in enumerate(axes):
-        if k + cols >= len(axes):
-            ax.set_xlabel(x)
-        if k % cols == 0:
-            ax.set_ylabel(y)
-
-
-def save_figure(figure: Figure, path: Path) -> Path:
-    """Write a figure as PNG (Agg, without pyplot), making its folder; ExportError if not."""
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        FigureCanvasAgg(figure)  # attaches itself: savefig renders with Agg, not pyplot
-        figure.savefig(path, format="png", dpi=DPI)
-    except OSError as error:
-        raise ExportError(f"{path}: cannot write: {error.strerror or error}") from None
-    return path
-
-
 def _require(frame: pd.DataFrame, columns: Iterable[str | None]) -> None:
     known = [str(c) for c in frame.columns]
     for column in columns:
@@ -397,12 +414,6 @@ def _numeric(series: pd.Series, name: str) -> pd.Series:
         raise ConfigError(f"metric {name!r} holds {series.dtype} values, not numbers") from None
 
 
-def _levels(series: pd.Series) -> list[object]:
-    """Distinct values but nulls: numbers and booleans ascending, others as they appear."""
-    values = series.dropna().drop_duplicates()
-    return list(values.sort_values() if pd.api.types.is_numeric_dtype(series) else values)
-
-
 def _ordered(column: pd.Series) -> pd.Series:
     """A grouping key that sorts as :func:`_levels` orders the values of ``column``."""
     if pd.api.types.is_numeric_dtype(column):
@@ -417,7 +428,3 @@ def _positions(levels: list[object], values: pd.Series) -> np.ndarray:
 
 def _where(frame: pd.DataFrame, column: str | None, value: object) -> pd.DataFrame:
     return frame if column is None else frame[frame[column] == value]
-
-
-def _label(value: object) -> str:
-    return f"{value:g}" if isinstance(value, float | np.floating) else str(value)

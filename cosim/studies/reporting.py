@@ -19,11 +19,12 @@ from cosim.studies.analysis import (
     RESULTS_FILE,
     heatmap,
     load_results,
-    metric_figure,
+    metric_figure_data,
     save_figure,
     standard_figures,
     write_report,
 )
+from cosim.studies.labels import axis_label, short_label
 from cosim.studies.spec import StudySpec
 from cosim.studies.timeseries import timeseries_figures
 
@@ -159,9 +160,10 @@ def loglog_figures(
 ) -> tuple[list[Path], list[str]]:
     """Plot each metric against ``x`` on log-log axes to ``figures/<metric>_vs_<x>_loglog.png``.
 
-    Means over seeds with their 95 % bands, as :func:`cosim.studies.analysis.plot_metric`
-    draws them; runs whose ``x`` or metric is not > 0 are left out. A metric no ok run reports is
-    skipped (the report's tables say why).
+    Means over seeds with their 95 % bootstrap bands, as
+    :func:`cosim.studies.analysis.plot_metric` draws them, and what is drawn in
+    ``<figure>.csv``; runs whose ``x`` or metric is not > 0 are left out. A metric no ok run
+    reports is skipped (the report's tables say why).
 
     Returns:
         The figures written, and a note for the report per metric with runs left out.
@@ -193,10 +195,9 @@ def loglog_figures(
             )
         if not usable.any():
             continue
-        figure = loglog_figure(ok[usable], x, metric, hue=hue, facet=facet)
-        paths.append(
-            save_figure(figure, Path(study_dir) / FIGURES_DIR / f"{metric}_vs_{x}_loglog.png")
-        )
+        figure, drawn = loglog_figure_data(ok[usable], x, metric, hue=hue, facet=facet)
+        target = Path(study_dir) / FIGURES_DIR / f"{metric}_vs_{x}_loglog.png"
+        paths.append(save_figure(figure, target, data=drawn))
     return paths, notes
 
 
@@ -209,9 +210,20 @@ def loglog_figure(
     facet: str | None = None,
 ) -> Figure:
     """The figure of :func:`cosim.studies.analysis.metric_figure` on log-log axes (values > 0)."""
-    figure = metric_figure(
-        results, x, metric, hue=hue, facet=facet, title=f"{metric} vs {x} (log-log)"
-    )
+    return loglog_figure_data(results, x, metric, hue=hue, facet=facet)[0]
+
+
+def loglog_figure_data(
+    results: pd.DataFrame,
+    x: str,
+    metric: str,
+    *,
+    hue: str | None = None,
+    facet: str | None = None,
+) -> tuple[Figure, pd.DataFrame]:
+    """:func:`loglog_figure` and what it draws (group columns, n, mean, low, high)."""
+    title = f"{axis_label(metric)} vs {short_label(x)} (log-log)"
+    figure, drawn = metric_figure_data(results, x, metric, hue=hue, facet=facet, title=title)
     levels = np.unique(results[x].to_numpy(dtype=float))
     for ax in figure.axes:
         ax.set_xscale("log")
@@ -220,4 +232,4 @@ def loglog_figure(
         if len(levels) <= MAX_X_TICKS:  # the studied values themselves, not powers of ten
             ax.set_xticks(levels, [f"{v:g}" for v in levels])
             ax.xaxis.set_minor_locator(NullLocator())
-    return figure
+    return figure, drawn

@@ -3,7 +3,8 @@
 A study that keeps a table per run (``tables = ["map_quality"]``) can ask for a metric of
 it over time: ``timeseries = [{table = "map_quality", y = "iou", where = {robot = "fleet"}}]``.
 For each value of the report's ``x`` a figure shows, per ``facet`` a panel and per ``hue``
-a line, the mean over seeds of ``y`` against ``t_s`` with its 95 % Student t band.
+a line, the mean over seeds of ``y`` against ``t_s`` with its 95 % bootstrap band
+(:mod:`cosim.studies.intervals`), and beside each figure a ``.csv`` of the series drawn.
 """
 
 from __future__ import annotations
@@ -14,19 +15,20 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
-from scipy import stats as scipy_stats
 
 from cosim.core.errors import ExportError
-from cosim.studies.analysis import FIGURES_DIR, load_results
-
-PANELS_PER_ROW = 3
-DPI = 150
-
-
-def _label(value: Any) -> str:
-    return f"{value:g}" if isinstance(value, float) else str(value)
+from cosim.studies.analysis import DRAWN, FIGURES_DIR, load_results
+from cosim.studies.intervals import band_caption, bootstrap_interval, y_limits
+from cosim.studies.labels import short_label, with_unit
+from cosim.studies.panels import (
+    PANELS_PER_ROW,
+    caption,
+    label_axes,
+    levels,
+    panels,
+    save_figure,
+    value_label,
+)
 
 
 def series_frame(
@@ -71,55 +73,61 @@ def timeseries_figures(
     written = []
     for x_value in pd.unique(data[x]) if x else [None]:
         part = data[data[x] == x_value] if x else data
-        suffix = f"_at_{x}={_label(x_value)}" if x else ""
+        suffix = f"_at_{x}={value_label(x_value)}" if x else ""
         target = Path(study_dir) / FIGURES_DIR / f"{y}_over_time{suffix}.png"
-        title = f"{table}.{y} over time" + (f", {x} = {_label(x_value)}" if x else "")
+        title = f"{short_label(y)} over time" + (
+            f", {with_unit(x, value_label(x_value))}" if x else ""
+        )
         if where:
             title += " (" + ", ".join(f"{k} = {v}" for k, v in where.items()) + ")"
         written.append(_draw(part, y, hue, facet, title, target))
     return written
 
 
+def series_band(lines: pd.DataFrame, y: str) -> pd.DataFrame:
+    """Per ``t_s``: n, mean, and the 95 % bootstrap interval of the mean of ``y`` (NaN dropped)."""
+    rows = []
+    for t, values in lines.dropna(subset=[y]).groupby("t_s", sort=True)[y]:
+        low, high = bootstrap_interval(values.to_numpy(float))
+        rows.append({"t_s": t, "n": len(values), "mean": values.mean(), "low": low, "high": high})
+    return pd.DataFrame(rows, columns=["t_s", *DRAWN])
+
+
 def _draw(
     data: pd.DataFrame, y: str, hue: str | None, facet: str | None, title: str, target: Path
 ) -> Path:
-    facets = list(pd.unique(data[facet])) if facet else [None]
-    rows = (len(facets) + PANELS_PER_ROW - 1) // PANELS_PER_ROW
-    cols = min(len(facets), PANELS_PER_ROW)
-    figure = Figure(figsize=(4.6 * cols + 1.6, 3.6 * rows + 0.6), layout="constrained")
-    axes = figure.subplots(rows, cols, sharey=True, squeeze=False).ravel()
-    for ax in axes[len(facets) :]:
-        ax.remove()
-    hues = list(pd.unique(data[hue])) if hue else [None]
-    for ax, facet_value in zip(axes, facets, strict=False):
+    facets, figure, axes = panels(data, facet, width_in=4.8)
+    hues = levels(data[hue]) if hue else [None]
+    drawn = []
+    for ax, facet_value in zip(axes, facets, strict=True):
         panel = data[data[facet] == facet_value] if facet else data
         for i, hue_value in enumerate(hues):
             lines = panel[panel[hue] == hue_value] if hue else panel
             if lines.empty:
                 continue
-            grouped = lines.groupby("t_s")[y]
-            mean, std, n = grouped.mean(), grouped.std(), grouped.count()
-            half = scipy_stats.t.ppf(0.975, np.maximum(n - 1, 1)) * std / np.sqrt(n)
-            half = half.where(n >= 2, 0.0).fillna(0.0)
-            t = mean.index.to_numpy(float)
-            color = f"C{i % 10}"
-            ax.plot(t, mean.to_numpy(float), color=color, label=_label(hue_value) if hue else None)
-            ax.fill_between(t, mean - half, mean + half, color=color, alpha=0.2, linewidth=0)
-        if facet:
-            ax.set_title(f"{facet} = {_label(facet_value)}", fontsize=10)
+            band = series_band(lines, y)
+            t, color = band["t_s"].to_numpy(float), f"C{i % 10}"
+            label = value_label(hue_value) if hue else None
+            ax.plot(t, band["mean"].to_numpy(float), color=color, label=label)
+            ax.fill_between(t, band["low"], band["high"], color=color, alpha=0.2, linewidth=0)
+            keys = [k for k in (facet, hue) if k is not None]
+            for key, value in zip((facet, hue), (facet_value, hue_value), strict=True):
+                if key is not None:
+                    band[key] = np.full(len(band), value, dtype=object)
+            drawn.append(band[[*keys, "t_s", *DRAWN]])
         ax.grid(True, alpha=0.3)
-        ax.set_xlabel("time (s)")
-    for ax in axes[:: max(cols, 1)]:
-        ax.set_ylabel(y)
+    table = pd.concat(drawn, ignore_index=True)
+    values = table[["mean", "low", "high"]].to_numpy(float)
+    if (limits := y_limits(values)) is not None:
+        axes[0].set_ylim(*limits)
+    label_axes(axes, "t_s", y)
     if hue:
         axes[min(len(facets), PANELS_PER_ROW) - 1].legend(
-            title=hue, fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0)
+            title=short_label(hue), fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0)
         )
-    figure.suptitle(title)
-    try:
-        target.parent.mkdir(parents=True, exist_ok=True)
-        FigureCanvasAgg(figure)
-        figure.savefig(target, dpi=DPI, bbox_inches="tight")
-    except OSError as error:
-        raise ExportError(f"{target}: cannot write: {error.strerror or error}") from None
-    return target
+    runs = data.groupby([c for c in ("seed", facet, hue) if c], dropna=False).ngroups
+    one_each = len(data) == runs * data["t_s"].nunique()  # a value per run and time
+    unit = "seeds" if one_each else f"values ({runs} runs)"
+    note = band_caption(table["n"].to_numpy(int), unit=unit, dots=False)
+    caption(figure, title, note)
+    return save_figure(figure, target, data=table)

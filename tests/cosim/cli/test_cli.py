@@ -361,6 +361,7 @@ def test_the_run_summary_leads_with_tasks_and_rounds_to_meaningful_digits(tmp_pa
     first, second = capsys.readouterr().out.splitlines()[:2]
     assert re.fullmatch(
         r"warehouse-random seed 1: 20 s simulated in \d+\.\d\d s \([\d.]+x real time\), "
+        r"(plus [\d.]+ s compiling kernels on this first run \(cached now\), )?"
         r"3 robots, [\d,]+ events, [\d,]+ messages",
         first,
     )

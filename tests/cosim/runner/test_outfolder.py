@@ -1,4 +1,4 @@
-"""--force replaces what an earlier run wrote, and nothing of the user's."""
+"""--force replaces what an earlier run wrote, and nothing of the user's; default folders."""
 
 import pandas as pd
 import pytest
@@ -6,7 +6,7 @@ import pytest
 import cosim
 from cosim.core.errors import ExportError
 from cosim.runner.execute import RunResult
-from cosim.runner.outfolder import prepare_out, write_run
+from cosim.runner.outfolder import default_out, prepare_out, write_run
 
 EARLIER = [
     "summary.json",
@@ -48,10 +48,57 @@ def _folder(tmp_path, files):
 @pytest.mark.slow  # the table names come from every installed adapter (imported: 0.5 s)
 def test_force_removes_an_earlier_runs_files_and_keeps_every_other(tmp_path):
     out = _folder(tmp_path, EARLIER + USERS)
-    prepare_out(out, force=True)
+    prepare_out(out, force=True, figures=True)
     assert sorted(str(p.relative_to(out)) for p in out.rglob("*") if p.is_file()) == sorted(USERS)
     assert not (out / "bag").exists()  # rosbags creates it afresh
     assert all((out / relative).read_text() == relative for relative in USERS)
+
+
+def test_force_keeps_the_figures_when_the_run_does_not_draw_them(tmp_path):
+    out = _folder(tmp_path, UNTABLED)
+    prepare_out(out, force=True)
+    figures = ["figures/run.gif", "figures/trajectories.png"]
+    assert sorted(str(p.relative_to(out)) for p in out.rglob("*") if p.is_file()) == figures
+    assert all((out / relative).read_text() == relative for relative in figures)
+
+
+def test_force_removes_the_earlier_figures_when_the_run_draws_its_own(tmp_path):
+    out = _folder(tmp_path, [*UNTABLED, "figures/poster.png"])
+    prepare_out(out, force=True, figures=True)
+    assert [str(p.relative_to(out)) for p in out.rglob("*") if p.is_file()] == [
+        "figures/poster.png"
+    ]
+
+
+def test_a_file_named_figures_is_in_the_way_only_of_a_run_that_draws(tmp_path):
+    out = _folder(tmp_path, ["summary.json", "figures"])
+    with pytest.raises(ExportError, match=r"figures: is a file where a run writes its figures/"):
+        prepare_out(out, force=True, figures=True)
+    assert (out / "summary.json").exists()
+    prepare_out(out, force=True)
+    assert [p.name for p in out.iterdir()] == ["figures"]
+
+
+def test_the_default_folder_is_taken_when_free_and_numbered_when_it_holds_a_run(tmp_path):
+    base = tmp_path / "runs" / "warehouse-random-seed1"
+    assert default_out(base) == base and base.is_dir()
+    assert default_out(base) == base  # still empty: nothing to collide with
+    (base / "summary.json").write_text("{}")
+    second = default_out(base)
+    assert second == tmp_path / "runs" / "warehouse-random-seed1-2" and second.is_dir()
+    (second / "summary.json").write_text("{}")
+    (tmp_path / "runs" / "warehouse-random-seed1-3").write_text("a file, not a folder")
+    assert default_out(base) == tmp_path / "runs" / "warehouse-random-seed1-4"
+    assert (base / "summary.json").read_text() == "{}"
+
+
+def test_a_default_folder_that_cannot_be_made_is_named_in_one_line(tmp_path):
+    (tmp_path / "runs").write_text("a file where the runs folder goes")
+    with pytest.raises(ExportError) as refused:
+        default_out(tmp_path / "runs" / "warehouse-random-seed1")
+    assert str(refused.value) == (
+        f"{tmp_path}/runs/warehouse-random-seed1: cannot make the results folder (Not a directory)"
+    )
 
 
 def test_without_force_nothing_is_removed_and_the_flag_is_named(tmp_path):

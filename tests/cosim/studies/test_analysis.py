@@ -4,7 +4,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from scipy import stats
+from matplotlib.collections import PathCollection, PolyCollection
 
 from cosim.core.errors import ConfigError, ExportError
 from cosim.studies.analysis import (
@@ -81,18 +81,21 @@ def _group(results: pd.DataFrame, protocol: str, latency: int) -> np.ndarray:
     return ok[(ok[HUE] == protocol) & (ok[X] == latency)]["tasks_per_min"].to_numpy()
 
 
-def test_aggregate_matches_a_direct_student_t_interval_for_every_group(results):
+def test_aggregate_matches_a_seeded_percentile_bootstrap_of_the_mean_for_every_group(results):
     table = aggregate(results, [HUE, X], ["tasks_per_min"], confidence=0.9)
     assert len(table) == len(PROTOCOLS) * len(LATENCIES)
     for row in table.to_dict("records"):
         values = _group(results, row[HUE], row[X])
         mean, std, n = values.mean(), values.std(ddof=1), len(values)
-        half = stats.t.ppf(0.95, n - 1) * std / np.sqrt(n)
+        rng = np.random.default_rng(0)
+        means = values[rng.integers(0, n, size=(2000, n))].mean(axis=1)
+        low, high = np.quantile(means, [0.05, 0.95])
         assert row["tasks_per_min_n"] == n == len(SEEDS)
         assert row["tasks_per_min_mean"] == pytest.approx(mean)
         assert row["tasks_per_min_std"] == pytest.approx(std)
-        assert row["tasks_per_min_ci_low"] == pytest.approx(mean - half)
-        assert row["tasks_per_min_ci_high"] == pytest.approx(mean + half)
+        assert row["tasks_per_min_ci_low"] == pytest.approx(low)
+        assert row["tasks_per_min_ci_high"] == pytest.approx(high)
+        assert values.min() <= low < mean < high <= values.max()
 
 
 def test_aggregate_gives_every_statistic_column_for_every_metric(results):
@@ -179,14 +182,21 @@ def test_a_non_numeric_metric_or_a_bad_confidence_is_a_config_error(results):
         aggregate(results, [X], ["tasks_per_min"], confidence=95)
 
 
-def test_metric_figure_draws_a_line_and_a_band_per_hue_value(results):
+def test_metric_figure_draws_a_line_a_band_and_each_runs_point_per_hue_value(results):
     figure = metric_figure(results, X, "tasks_per_min", hue=HUE)
     (ax,) = figure.axes[:1]
     lines = ax.get_lines()
     assert len(lines) == len(PROTOCOLS)
-    assert len(ax.collections) == len(PROTOCOLS)  # the CI bands
+    bands = [c for c in ax.collections if isinstance(c, PolyCollection)]
+    dots = [c for c in ax.collections if type(c) is PathCollection]
+    assert len(bands) == len(dots) == len(PROTOCOLS)
+    assert [len(d.get_offsets()) for d in dots] == [len(LATENCIES) * len(SEEDS)] * 3
     assert [text.get_text() for text in ax.get_legend().get_texts()] == PROTOCOLS
-    assert ax.get_xlabel() == X and ax.get_ylabel() == "tasks_per_min"
+    assert ax.get_legend().get_title().get_text() == "Assignment protocol"
+    assert ax.get_xlabel() == "Network latency (ms)" and ax.get_ylabel() == "Tasks per minute"
+    assert "band: 95 % bootstrap interval of the mean, n = 5 seeds per point" in (
+        figure.get_suptitle()
+    )
     table = aggregate(results, [HUE, X], ["tasks_per_min"])
     first = table[table[HUE] == PROTOCOLS[0]]
     np.testing.assert_array_equal(lines[0].get_xdata(), sorted(LATENCIES))
@@ -196,7 +206,9 @@ def test_metric_figure_draws_a_line_and_a_band_per_hue_value(results):
 def test_faceting_gives_a_subplot_per_value_sharing_the_y_axis(results):
     figure = metric_figure(results, X, "tasks_per_min", hue="seed", facet=HUE)
     assert len(figure.axes) == len(PROTOCOLS)
-    assert [ax.get_title() for ax in figure.axes] == [f"{HUE} = {p}" for p in PROTOCOLS]
+    assert [ax.get_title() for ax in figure.axes] == [
+        f"Assignment protocol = {p}" for p in PROTOCOLS
+    ]
     assert all(len(ax.get_lines()) == len(SEEDS) for ax in figure.axes)
     assert figure.axes[0].get_shared_y_axes().joined(figure.axes[0], figure.axes[2])
 
@@ -272,7 +284,8 @@ def test_the_report_has_counts_errors_a_table_per_metric_and_figure_links(study)
     assert "- `broken-6` (seed 6): ScenarioError: shelves do not fit\n" in text
     assert "- `broken-7` (seed 7): no message" in text
     assert "### tasks_per_min" in text
-    assert f"| {HUE}" in text and "±" in text
+    assert f"| {HUE}" in text and "95 % percentile bootstrap interval of the mean" in text
+    assert re.search(r"\| \d+\.?\d* \[\d+\.?\d*, \d+\.?\d*\] +\| +5 \|", text)
     assert text.count("| simplex ") == len(LATENCIES)
     assert "- `not_a_metric`: no such column in the results, skipped." in text
     assert f"![tasks_per_min_vs_{X}](figures/tasks_per_min_vs_{X}.png)" in text

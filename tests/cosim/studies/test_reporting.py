@@ -112,8 +112,12 @@ def test_a_loglog_report_writes_the_figure_links_it_and_tabulates_the_metric(tmp
     assert f"(figures/{FIGURE})" in report
     assert "### wall_us_per_robot_s" in report
     table = report.split("### wall_us_per_robot_s")[1].split("##")[0]
-    assert re.search(r"\|\s+4 \| 2\.75e\+03 ± .*\|\s+2 \|", table)  # mean of 2500 and 3000
-    assert re.search(r"\|\s+16 \| 5e\+03 ± 0 .*\|\s+2 \|", table)
+    # mean of 2500 and 3000; two runs: the bootstrap interval of the mean is their range
+    assert re.search(r"\|\s+4 \| 2\.75e\+03 \[2\.5e\+03, 3e\+03\] .*\|\s+2 \|", table)
+    assert re.search(r"\|\s+16 \| 5e\+03 \[5e\+03, 5e\+03\] .*\|\s+2 \|", table)
+    drawn = pd.read_csv(png.with_suffix(".csv"))
+    assert list(drawn.columns) == [X, "n", "mean", "low", "high"]
+    assert drawn.loc[0].tolist() == pytest.approx([4, 2, 2750.0, 2500.0, 3000.0])
     assert "1e6 x wall_time_s / (robots x sim_time_s)" in report
     # listed only under loglog: no linear figure of it; collisions (in metrics too) has both
     assert not (tmp_path / "out" / "figures" / "wall_us_per_robot_s_vs_robots.count.png").exists()
