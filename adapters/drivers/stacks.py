@@ -21,3 +21,9 @@ WAYPOINTS = Driver(
     needs_lidar=False,
 )
 WANDER = Driver(("wander",), "reactive roaming that steers away from what the lidar sees")
+TELEOP = Driver(
+    ("teleop",),
+    "an operator's velocity commands (a Unity scene's /<robot>/cmd_vel), stopped 0.5 s after "
+    "the last one, avoiding nothing",
+    needs_lidar=False,
+)

@@ -180,4 +180,8 @@ def open_live_source(
     """Connect the live source ``cfg.source`` names."""
     if cfg.source == "motioncapture":
         return MotionCaptureSource(run, cfg, bodies)
+    if cfg.source == "unity":
+        from adapters.mocap.unity import UnityPoseSource  # it imports this module's Sample
+
+        return UnityPoseSource(run, cfg, bodies)
     return Ros2PoseSource(run, cfg, bodies)

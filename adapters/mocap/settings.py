@@ -18,10 +18,13 @@ from typing import ClassVar, Literal
 from adapters.ros2dds.naming import dds_topic
 from cosim.scenario.fields import Problem, param
 
-MocapSource = Literal["none", "simulated", "bag", "motioncapture", "ros2"]
+MocapSource = Literal["none", "simulated", "bag", "motioncapture", "ros2", "unity"]
 
-EXTERNAL_SOURCES = ("bag", "motioncapture", "ros2")
+EXTERNAL_SOURCES = ("bag", "motioncapture", "ros2", "unity")
 """Sources whose poses come from outside the simulation: they move the robots they track."""
+
+LIVE_SOURCES = ("motioncapture", "ros2", "unity")
+"""External sources that send poses while the run goes (on the wall clock)."""
 
 SYSTEMS = ("vicon", "optitrack", "qualisys", "vrpn", "mock")
 """Backends the motioncapture 1.1 wheel supports (others: "Unknown motion capture type!")."""
@@ -41,8 +44,9 @@ class MocapConfig:
         "none",
         "where the poses come from: none (robots localize by odometry), simulated (from "
         "ground truth with rate, latency, noise, dropouts), bag (a recorded ROS 2 bag or a "
-        "CSV replayed), motioncapture (live, through the motioncapture library), or ros2 "
-        "(live PoseStamped topics over DDS)",
+        "CSV replayed), motioncapture (live, through the motioncapture library), ros2 "
+        "(live PoseStamped topics over DDS), or unity (live PoseStamped topics a Unity scene "
+        "publishes to `cosim run --unity`)",
     )
     robots: tuple[str, ...] = param(
         (), "simulated: the robots tracked (empty: all); other sources: see bodies"
@@ -50,9 +54,9 @@ class MocapConfig:
     bodies: tuple[tuple[str, str], ...] = param(
         (),
         "[[robot, body], ...]: what tracks each robot; body is a topic in the bag (bag), a "
-        "rigid-body name (motioncapture) or a ROS topic (ros2). Empty: robot_0 with the "
-        "bag's only pose topic (bag), each physical robot by its name (motioncapture) or "
-        "on topic_pattern (ros2)",
+        "rigid-body name (motioncapture) or a ROS topic (ros2, unity). Empty: robot_0 with "
+        "the bag's only pose topic (bag), each physical robot by its name (motioncapture) "
+        "or on topic_pattern (ros2, unity)",
     )
     rate_hz: float = param(100.0, "simulated: frames per second (Hz)", gt=0, le=2000)
     latency_ms: float = param(
@@ -81,12 +85,12 @@ class MocapConfig:
     hostname: str = param("", "motioncapture: the mocap server's address")
     topic_pattern: str = param(
         "/{robot}/pose",
-        "ros2: the PoseStamped topic of each physical robot, {robot} standing for its name "
-        "(the only token; ros2-vicon-receiver publishes /vicon/<subject>/<segment>)",
+        "ros2, unity: the PoseStamped topic of each physical robot, {robot} standing for its "
+        "name (the only token; ros2-vicon-receiver publishes /vicon/<subject>/<segment>)",
     )
     connect_timeout_s: float = param(
         10.0,
-        "motioncapture, ros2: a live source that has not connected, or has sent no pose of "
+        "motioncapture, ros2, unity: a live source that has not connected, or has sent no pose of "
         "a tracked robot, this long after the run started ends the run with an error naming "
         "the system, its host and the robot (s)",
         gt=0,
@@ -107,19 +111,22 @@ class MocapConfig:
             yield Problem(
                 "bodies",
                 [list(b) for b in self.bodies],
-                "no bodies unless source is 'bag', 'motioncapture' or 'ros2'",
+                "no bodies unless source is 'bag', 'motioncapture', 'ros2' or 'unity'",
             )
         tracked = [robot for robot, _ in self.bodies]
         if len(set(tracked)) != len(tracked):
             yield Problem("bodies", [list(b) for b in self.bodies], "each robot tracked once")
         yield from self._pattern_problems()
-        if self.source == "ros2" and "{robot}" not in self.topic_pattern and not self.bodies:
+        by_topic = self.source in ("ros2", "unity")
+        if by_topic and "{robot}" not in self.topic_pattern and not self.bodies:
             yield Problem("topic_pattern", self.topic_pattern, "a pattern containing {robot}")
-        if self.source == "ros2":
+        if by_topic:
             for robot, body in self.bodies:
                 reason = _topic_problem(body)
                 if reason is not None:
-                    yield Problem("bodies", [robot, body], f"a ROS 2 topic for ros2 ({reason})")
+                    yield Problem(
+                        "bodies", [robot, body], f"a ROS 2 topic for {self.source} ({reason})"
+                    )
         if self.source == "motioncapture":
             if self.system not in SYSTEMS:
                 yield Problem("system", self.system, f"one of {', '.join(SYSTEMS)}")
@@ -167,7 +174,7 @@ class MocapConfig:
 
     def needs_realtime(self) -> bool:
         """A live system sends poses on the wall clock: the run must keep pace with it."""
-        return self.source in ("motioncapture", "ros2")
+        return self.source in LIVE_SOURCES
 
 
 def _topic_problem(name: str) -> str | None:

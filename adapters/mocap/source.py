@@ -7,11 +7,13 @@
   commands as usual; their software localizes by these poses.
 * ``bag``: a recorded trajectory (ROS 2 bag or CSV) replayed at its own stamps, shifted so
   the first pose falls at time 0; the replayed robot is a twin that follows it.
-* ``motioncapture`` / ``ros2``: live poses (the ``motioncapture`` library, or PoseStamped
-  topics over DDS) taken in at ``mocap.rate_hz``; stamps are wall clock, mapped to kernel
-  time by the real-time kernel; the tracked robots are twins. The run never waits for the
-  system: a source that fails ends the run at once, and one that has sent no pose of some
-  tracked robot ``mocap.connect_timeout_s`` after the start ends it then
+* ``motioncapture`` / ``ros2`` / ``unity``: live poses (the ``motioncapture`` library,
+  PoseStamped topics over DDS, or PoseStamped topics Unity scenes publish to ``cosim run
+  --unity``, :mod:`adapters.mocap.unity`) taken in at ``mocap.rate_hz``; stamps are wall
+  clock, mapped to kernel time by the real-time kernel (Unity's: when the run took them
+  in); the tracked robots are twins. The run never waits for the system: a source that
+  fails ends the run at once, and one that has sent no pose of some tracked robot
+  ``mocap.connect_timeout_s`` after the start ends it then
   (:class:`~adapters.mocap.live.LiveSourceError`, one line naming the system, its host,
   the robot and what was listened for; an event ``no_pose`` or ``mocap_failed``).
 
@@ -34,6 +36,7 @@ from adapters.mocap.settings import MocapConfig
 from adapters.mocap.tables import MOCAP, MocapRecords
 from adapters.mocap.tracking import external_bodies, simulated_robots
 from adapters.mocap.tracks import PoseTrack, read_pose_track
+from adapters.mocap.unity import advertise_unity_poses
 from cosim.core.adapter import RunContext
 from cosim.core.errors import ConfigError
 from cosim.core.hosts import HostKind
@@ -98,6 +101,8 @@ class MocapAdapter:
             mirrors = self.intake.mirrors
             for index in self.tracked:
                 mirrors.add(index)
+            if cfg.source == "unity":
+                advertise_unity_poses(run, self.bodies)
             if cfg.source == "bag":
                 self.tracks = [
                     (index, read_pose_track(Path(cfg.file), body or None))
@@ -195,11 +200,10 @@ class MocapAdapter:
     def _expected(self) -> str:
         """What a live source needs, and the keys that say where it is."""
         cfg = self.cfg
-        keys = (
-            "mocap.system, mocap.hostname and mocap.bodies"
-            if cfg.source == "motioncapture"
-            else "mocap.bodies or mocap.topic_pattern, and physical.dds_domain"
-        )
+        keys = {
+            "motioncapture": "mocap.system, mocap.hostname and mocap.bodies",
+            "unity": "mocap.bodies or mocap.topic_pattern, and cosim run --unity",
+        }.get(cfg.source, "mocap.bodies or mocap.topic_pattern, and physical.dds_domain")
         return (
             f"expected a pose of every tracked robot within mocap.connect_timeout_s = "
             f"{cfg.connect_timeout_s:g} s (see {keys})"

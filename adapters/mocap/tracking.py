@@ -22,10 +22,10 @@ def _check_names(scenario: ScenarioView, names: list[str], robots: list[str], ke
 
 
 def external_bodies(scenario: ScenarioView, names: list[str]) -> list[tuple[str, str]]:
-    """(robot, body) of an external mocap source (``bag``, ``motioncapture``, ``ros2``).
+    """(robot, body) of an external mocap source (``bag``, ``motioncapture``, ``ros2``, ``unity``).
 
     Defaults: the first robot with the bag's only pose topic; each physical robot by its
-    own name (``motioncapture``) or on ``mocap.topic_pattern`` (``ros2``).
+    own name (``motioncapture``) or on ``mocap.topic_pattern`` (``ros2``, ``unity``).
 
     Raises:
         ConfigError: for unknown robots, or a live source that tracks nobody.
@@ -43,7 +43,7 @@ def external_bodies(scenario: ScenarioView, names: list[str]) -> list[tuple[str,
                 f"{scenario.source}: [mocap] bodies = []: expected [[robot, body], ...] or "
                 f"physical.robots for source = {cfg.source!r}"
             )
-        elif cfg.source == "ros2":
+        elif cfg.source in ("ros2", "unity"):
             pairs = [(r, cfg.topic_pattern.replace("{robot}", r)) for r in physical]
         else:
             pairs = [(r, r) for r in physical]
@@ -61,7 +61,7 @@ def physical_robots(scenario: ScenarioView, names: list[str]) -> list[str]:
     _check_names(scenario, names, robots, "physical.robots")
     if scenario.section(PhysicalConfig).pose == "mocap" and robots:
         tracked = {robot for robot, _ in external_bodies(scenario, names)}
-        live = scenario.section(MocapConfig).source in ("motioncapture", "ros2")
+        live = scenario.section(MocapConfig).needs_realtime()
         missing = [robot for robot in robots if robot not in tracked or not live]
         if missing:
             raise ConfigError(

@@ -248,6 +248,26 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="start the run only once a viewer has subscribed to a topic",
     )
+    unity = run.add_argument_group(
+        "Unity",
+        "Serve the run as a ROS-TCP-Endpoint (ROS-TCP-Connector 0.7, ROS 2 mode), paced "
+        "against the wall clock: in Unity, Robotics > ROS Settings > ROS IP Address and Port.",
+    )
+    unity.add_argument(
+        "--unity", action="store_true", help="serve the run to Unity scenes (ROS-TCP-Connector)"
+    )
+    unity.add_argument(
+        "--unity-port",
+        type=_port,
+        default=10000,
+        help="TCP port Unity connects to (default 10000, the Connector's)",
+    )
+    unity.add_argument(
+        "--unity-host",
+        type=host_argument,
+        default="127.0.0.1",
+        help="address to bind (default 127.0.0.1: this machine only; 0.0.0.0: every interface)",
+    )
 
     check = commands.add_parser(
         "check",

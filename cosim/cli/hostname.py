@@ -47,21 +47,22 @@ def host_argument(text: str) -> str:
     return text
 
 
-def check_live_host(host: str) -> None:
-    """Refuse a ``--live-host`` that does not resolve or is not an address of this machine.
+def check_live_host(host: str, flag: str = "--live-host") -> None:
+    """Refuse a host flag's value that does not resolve or is not an address of this machine.
 
     Binds a socket to the address (any free port) and closes it; the live view's own port
     is tried later, when the run starts.
 
     Raises:
-        ConfigError: one line naming ``--live-host``, the value and what was expected.
+        ConfigError: one line naming ``flag`` (``--live-host``, ``--unity-host``), the value
+            and what was expected.
     """
     try:
         found = socket.getaddrinfo(host, None, type=socket.SOCK_STREAM)
     except (OSError, UnicodeError) as error:
         reason = getattr(error, "strerror", None) or str(error)
         raise ConfigError(
-            f"--live-host {host!r}: cannot resolve it ({reason}); expected {EXPECTED}"
+            f"{flag} {host!r}: cannot resolve it ({reason}); expected {EXPECTED}"
         ) from None
     family, _type, _proto, _name, address = found[0]
     try:
@@ -69,6 +70,6 @@ def check_live_host(host: str) -> None:
             probe.bind((address[0], 0, *address[2:]))
     except OSError as error:
         raise ConfigError(
-            f"--live-host {host!r}: cannot listen on {address[0]} ({error.strerror or error}); "
+            f"{flag} {host!r}: cannot listen on {address[0]} ({error.strerror or error}); "
             "expected an address of this machine (127.0.0.1, 0.0.0.0 for every interface)"
         ) from None

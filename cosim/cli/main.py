@@ -116,6 +116,7 @@ def _run_and_report(args: argparse.Namespace, stop: StopRequest, ran: list[Path]
     from adapters.ros2dds.domain import claim_run_domain
     from cosim.cli.hostname import check_live_host
     from cosim.recording.foxglove import LiveOptions
+    from cosim.recording.unity import UnityOptions
     from cosim.runner.execute import run
     from cosim.runner.stopping import RunStopped
 
@@ -126,6 +127,8 @@ def _run_and_report(args: argparse.Namespace, stop: StopRequest, ran: list[Path]
         scenario = scenario.with_seed(args.seed)
     if args.live:
         check_live_host(args.live_host)
+    if args.unity:
+        check_live_host(args.unity_host, flag="--unity-host")
     out = _out_folder(args, scenario, quiet=args.quiet)
     live = (
         LiveOptions(args.live_host, args.live_port, args.live_rate, args.live_wait)
@@ -157,6 +160,7 @@ def _run_and_report(args: argparse.Namespace, stop: StopRequest, ran: list[Path]
                 on_ready=lambda session: _ready(session, quiet=args.quiet),
                 stop=stop,
                 figures=args.figures or args.gif,
+                unity=UnityOptions(args.unity_host, args.unity_port) if args.unity else None,
             )
         except RunStopped as stopped:
             if stopped.result is not None and stopped.result.out is not None:
@@ -219,7 +223,14 @@ def _stopped_line(stopped: RunStopped, ran: list[Path]) -> str:
 
 
 def _ready(session: RecordingSession, *, quiet: bool) -> None:
-    """Say where the live view is; hold the run for a viewer when asked to."""
+    """Say where the live view and the Unity endpoint are; hold the run for a viewer if asked."""
+    unity = session.unity
+    if unity is not None and not quiet:
+        print(
+            f"unity: ROS-TCP-Endpoint on {unity.options.host}:{unity.port}  (Unity: Robotics > "
+            "ROS Settings: Protocol ROS2, ROS IP Address and Port; real time)",
+            flush=True,
+        )
     live = session.live
     if live is None:
         return

@@ -19,6 +19,7 @@ from cosim.recording.foxglove import LiveOptions, LiveSink
 from cosim.recording.schemas import channel_specs
 from cosim.recording.selection import select_topics
 from cosim.recording.tap import RecordingTap, Sink
+from cosim.recording.unity import UnityOptions, UnitySink
 from cosim.scenario.model import Scenario
 
 
@@ -31,26 +32,37 @@ class RecordingPlan:
         storage: ``"mcap"`` or ``"sqlite3"``.
         compression: ``"zstd"`` or ``"none"``.
         live: the live view's options, or None.
+        unity: the Unity endpoint's options (``--unity``), or None.
     """
 
     bag: Path | None = None
     storage: str = "mcap"
     compression: str = "zstd"
     live: LiveOptions | None = None
+    unity: UnityOptions | None = None
 
     @property
     def active(self) -> bool:
         """Whether anything is recorded or served."""
-        return self.bag is not None or self.live is not None
+        return self.bag is not None or self.live is not None or self.unity is not None
+
+    @property
+    def realtime(self) -> bool:
+        """Whether the run is served as it goes, so paced by the wall clock."""
+        return self.live is not None or self.unity is not None
 
     @classmethod
     def for_run(
-        cls, scenario: Scenario, out: Path | None, live: LiveOptions | None = None
+        cls,
+        scenario: Scenario,
+        out: Path | None,
+        live: LiveOptions | None = None,
+        unity: UnityOptions | None = None,
     ) -> RecordingPlan:
-        """The bag in ``out/bag`` per ``record.bag`` (none without a folder), and the live view."""
+        """The bag in ``out/bag`` per ``record.bag`` (none without a folder), the live servers."""
         record = scenario.record
         bag = out / BAG_DIR if out is not None and record.bag != "none" else None
-        return cls(bag, record.bag, record.compression, live)
+        return cls(bag, record.bag, record.compression, live, unity)
 
 
 @dataclass
@@ -68,6 +80,7 @@ class RecordingSession:
     bus: Bus
     bag: BagSink | None = field(init=False, default=None)
     live: LiveSink | None = field(init=False, default=None)
+    unity: UnitySink | None = field(init=False, default=None)
     tap: RecordingTap | None = field(init=False, default=None)
     _closed: bool = field(init=False, default=False)
 
@@ -81,14 +94,14 @@ class RecordingSession:
         return select_topics(scenario.record.topics, bus.advertised(), origin=scenario.source)
 
     def open(self, *, before_bag: Callable[[], None] | None = None) -> None:
-        """Start the live server, create the bag and tap the bus.
+        """Start the live servers, create the bag and tap the bus.
 
         Args:
             before_bag: called once the live server listens and before the bag exists (the
                 run folder is prepared there, so a taken port leaves it untouched).
 
         Raises:
-            BridgeError: the live view cannot listen on its port.
+            BridgeError: the live view or the Unity endpoint cannot listen on its port.
             ExportError: the bag cannot be created.
         """
         channels = channel_specs(self.topics)
@@ -98,6 +111,10 @@ class RecordingSession:
                 self.live = LiveSink(self.plan.live)
                 self.live.open(channels)
                 opened.append(self.live)
+            if self.plan.unity is not None:
+                self.unity = UnitySink(self.plan.unity, self.bus)
+                self.unity.open(channels)
+                opened.append(self.unity)
             if before_bag is not None:
                 before_bag()
             if self.plan.bag is not None:
@@ -121,3 +138,7 @@ class RecordingSession:
     def counts(self) -> dict[str, int]:
         """Messages recorded per topic."""
         return self.tap.message_counts() if self.tap is not None else {}
+
+    def summary(self) -> dict[str, int]:
+        """What the live servers add to the run's summary (Unity's connections and frames)."""
+        return self.unity.summary() if self.unity is not None else {}

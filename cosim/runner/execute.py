@@ -22,6 +22,7 @@ from cosim.core.registry import AdapterRegistry
 from cosim.core.timebase import NS_PER_S, s_to_ns
 from cosim.recording.foxglove import LiveOptions
 from cosim.recording.setup import RecordingPlan, RecordingSession
+from cosim.recording.unity import UnityOptions
 from cosim.runner.assembly import Assembly, assemble
 from cosim.runner.compiletime import CompileClock
 from cosim.runner.outfolder import prepare_out, write_run
@@ -96,6 +97,7 @@ def execute(
     adapters: Sequence[str | AdapterType] = (),
     stop: StopRequest | None = None,
     figures: bool = False,
+    unity: UnityOptions | None = None,
 ) -> RunResult:
     """Run a scenario to its duration and return its result.
 
@@ -112,6 +114,7 @@ def execute(
             ``record.bag``); the other results are written by :func:`write_run`.
         force: replace the results in a non-empty ``out``.
         live: serve the run to Foxglove over WebSocket, paced by the real-time kernel.
+        unity: serve the run to Unity scenes as a ROS-TCP-Endpoint, paced likewise.
         on_ready: called with the recording session once sinks are open, before the run
             (the command line prints the live view's address there).
         adapters: more adapters to run: registered names, or adapter classes (used for
@@ -131,7 +134,7 @@ def execute(
     """
     with CompileClock() as clock:  # numba's compile time, said apart from the speed
         with _immediate(stop):
-            plan = RecordingPlan.for_run(scenario, out, live)
+            plan = RecordingPlan.for_run(scenario, out, live, unity)
             registry, extra = with_adapters(
                 registry or AdapterRegistry.from_entry_points(), adapters
             )
@@ -140,7 +143,7 @@ def execute(
                 names=names,
                 registry=registry,
                 extra=extra,
-                realtime=live is not None,
+                realtime=plan.realtime,
                 speed=live.rate if live is not None else 1.0,
                 recording=plan.active,
             )
@@ -170,6 +173,7 @@ def execute(
     result.compile_time_s = round(clock.seconds, 3)
     result.bag = plan.bag
     result.recorded = session.counts()
+    result.summary.update(session.summary())
     if result.failure is not None:
         result.failure.kept = result
         raise result.failure
@@ -354,6 +358,7 @@ def run(
     adapters: Sequence[str | AdapterType] = (),
     stop: StopRequest | None = None,
     figures: bool = False,
+    unity: UnityOptions | None = None,
 ) -> RunResult:
     """Run a scenario; optionally write its folder.
 
@@ -372,6 +377,8 @@ def run(
         force: replace the results in a non-empty ``out``.
         progress: called with (sim s, duration s, wall s) during the run.
         live: serve the run live to Foxglove (see :class:`cosim.recording.foxglove.LiveOptions`).
+        unity: serve the run to Unity's ROS-TCP-Connector scenes (see
+            :class:`cosim.recording.unity.UnityOptions`), paced in real time.
         on_ready: called once the recording is set up, before the run starts.
         adapters: more adapters to run: registered names, or adapter classes (a class is
             used for this run as if registered under its ``name``; the resolved
@@ -410,6 +417,7 @@ def run(
                 adapters=adapters,
                 stop=stop,
                 figures=figures,
+                unity=unity,
             )
         except BridgeError as error:
             if error.kept is None or folder is None:
