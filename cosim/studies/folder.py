@@ -463,12 +463,20 @@ def collect(spec: StudySpec, out: Path) -> pd.DataFrame:
     """
     frame = pd.DataFrame(finished_rows(spec, out))
     if len(frame):
-        path = out / RESULTS_FILE
-        partial = path.with_name(path.name + PARTIAL)
-        try:
-            frame.to_parquet(partial, index=False)
-            os.replace(partial, path)
-        except OSError as error:
-            partial.unlink(missing_ok=True)
-            raise ExportError(f"{path}: cannot write the results ({_reason(error)})") from None
+        write_results(frame, out / RESULTS_FILE)
     return frame
+
+
+def write_results(frame: pd.DataFrame, path: Path) -> None:
+    """Write a study's results beside ``path``, then rename: a full disk keeps the old file.
+
+    Raises:
+        ExportError: the results cannot be written (read-only, full).
+    """
+    partial = path.with_name(path.name + PARTIAL)
+    try:
+        frame.to_parquet(partial, index=False)
+        os.replace(partial, path)
+    except OSError as error:
+        partial.unlink(missing_ok=True)
+        raise ExportError(f"{path}: cannot write the results ({_reason(error)})") from None

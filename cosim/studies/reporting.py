@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import os
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -13,7 +12,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.ticker import NullLocator
 
-from cosim.core.errors import ConfigError, ExportError
+from cosim.core.errors import ConfigError
 from cosim.studies.analysis import (
     FIGURES_DIR,
     RESULTS_FILE,
@@ -24,6 +23,7 @@ from cosim.studies.analysis import (
     standard_figures,
     write_report,
 )
+from cosim.studies.folder import write_results
 from cosim.studies.labels import axis_label, short_label
 from cosim.studies.spec import StudySpec
 from cosim.studies.timeseries import timeseries_figures
@@ -139,14 +139,7 @@ def add_derived_metrics(study_dir: Path, names: Sequence[str]) -> list[str]:
             results[name] = metric.compute(results)
             added.append(name)
     if added:
-        path = Path(study_dir) / RESULTS_FILE
-        partial = path.with_name(path.name + ".partial")  # a full disk keeps the old file
-        try:
-            results.to_parquet(partial, index=False)
-            os.replace(partial, path)
-        except OSError as error:
-            partial.unlink(missing_ok=True)
-            raise ExportError(f"{path}: cannot write: {error.strerror or error}") from None
+        write_results(results, Path(study_dir) / RESULTS_FILE)
     return added
 
 

@@ -88,19 +88,28 @@ def decode_goal(robot: str, data: bytes) -> UnityGoal:
     return UnityGoal(robot, x, y, yaw)
 
 
+def _decode(topic: str, data: bytes, msgtype: str) -> Any:
+    """A scene's CDR bytes as a ``msgtype`` message (rosbags' typestore), nothing evaluated.
+
+    Raises:
+        ValueError: naming ``topic``, the byte count and rosbags' reason.
+    """
+    try:
+        return typestore().deserialize_cdr(data, msgtype)
+    except Exception as problem:  # rosbags raises several kinds on bytes it cannot follow
+        raise ValueError(
+            f"{topic}: {len(data)} bytes are not a CDR {msgtype} "
+            f"({type(problem).__name__}: {problem})"
+        ) from None
+
+
 def _planar_pose(topic: str, data: bytes) -> tuple[float, float, float]:
     """(x_m, y_m, yaw_rad) in ``map`` of a CDR PoseStamped; yaw ``nan`` for a zero quaternion.
 
     Raises:
         ValueError: naming ``topic`` and what is wrong.
     """
-    try:
-        message: Any = typestore().deserialize_cdr(data, GOAL_TYPE)
-    except Exception as problem:  # rosbags raises several kinds on bytes it cannot follow
-        raise ValueError(
-            f"{topic}: {len(data)} bytes are not a CDR {GOAL_TYPE} "
-            f"({type(problem).__name__}: {problem})"
-        ) from None
+    message = _decode(topic, data, GOAL_TYPE)
     frame_id = message.header.frame_id
     if frame_id != GOAL_FRAME:
         raise ValueError(f"{topic}: header.frame_id is {frame_id!r}; expected {GOAL_FRAME!r}")
@@ -163,13 +172,7 @@ def decode_twist(robot: str, data: bytes) -> UnityTwist:
     Raises:
         ValueError: naming what is wrong (bytes that do not decode, a value not finite).
     """
-    try:
-        message: Any = typestore().deserialize_cdr(data, TWIST_TYPE)
-    except Exception as problem:  # rosbags raises several kinds on bytes it cannot follow
-        raise ValueError(
-            f"/{robot}/cmd_vel: {len(data)} bytes are not a CDR {TWIST_TYPE} "
-            f"({type(problem).__name__}: {problem})"
-        ) from None
+    message = _decode(f"/{robot}/cmd_vel", data, TWIST_TYPE)
     linear, angular = message.linear, message.angular
     values = [float(v) for v in (linear.x, linear.y, linear.z, angular.x, angular.y, angular.z)]
     if not all(math.isfinite(v) for v in values):

@@ -11,6 +11,8 @@ from typing import Any
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from cosim.core.bus import Bus, TopicQos
 from cosim.core.errors import BridgeError
@@ -207,3 +209,62 @@ def test_goals_from_unity_keep_the_hosts_robot_as_source(served: Served) -> None
     served.sink.goals.put(UnityGoal("robot_1", 1.0, 1.0, 0.0))
     served.kernel.run(100_000_000)
     assert sources == [HostId("robot_1")]
+
+
+DESTINATIONS = st.one_of(
+    st.sampled_from(
+        [
+            "__subscribe",
+            "__publish",
+            "__topic_list",
+            "__request",
+            "__ros_service",
+            "__remove_subscriber",
+            "/robot_1/goal_pose",
+            "/robot_1/scan",
+            "/tf",
+            "",
+        ]
+    ),
+    st.text(max_size=40),
+)
+PAYLOADS = st.one_of(
+    st.binary(max_size=200),
+    st.dictionaries(
+        st.sampled_from(["topic", "message_name", "srv_id", "latch"]),
+        st.one_of(st.text(max_size=20), st.integers(), st.none()),
+        max_size=4,
+    ).map(lambda d: json.dumps(d).encode() + b"\x00"),
+)
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.lists(st.tuples(DESTINATIONS, PAYLOADS), min_size=1, max_size=6))
+def test_any_well_framed_garbage_is_answered_or_counted_and_the_server_serves_on(
+    frames: list[tuple[str, bytes]],
+) -> None:
+    served = Served()
+    try:
+        client = served.client()
+        for destination, payload in frames:
+            client.sock.sendall(connector_string(destination) + struct.pack("<I", len(payload)))
+            client.sock.sendall(payload)
+        answer = _round_trip(served.client())  # a second scene is served whatever the first sent
+        assert "/robot_1/scan" in answer["topics"]
+        served.kernel.run(100_000_000)
+        # a goal gets in only when it was a valid pose: finite, in the map frame
+        assert all(math.isfinite(getattr(goal, "x_m", math.nan)) for goal in served.goals)
+    finally:
+        served.sink.close()
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.binary(min_size=1, max_size=300))
+def test_bytes_that_break_the_framing_close_that_connection_only(raw: bytes) -> None:
+    served = Served()
+    try:
+        client = served.client()
+        client.sock.sendall(raw)
+        assert _round_trip(served.client())["topics"]  # another scene is served as before
+    finally:
+        served.sink.close()
