@@ -16,10 +16,10 @@ from typing import Any
 
 import numpy as np
 
-from models.kinematics import DriveLimits
+from models.fleet.kinematics import DriveLimits
 from models.navigation.dwa import DwaParams, dwa_batch
-from models.raycast import StaticScene, cast_batch
-from models.world import WarehouseSpec, generate_warehouse
+from models.sensing.raycast import StaticScene, cast_batch
+from models.world.warehouse import WarehouseSpec, generate_warehouse
 
 Result = dict[str, Any]
 

@@ -12,9 +12,9 @@ from typing import Any
 import numpy as np
 
 from models.errors import ModelError
-from models.lidar import cast_reference
-from models.raycast import StaticScene, cast_batch, scene_cell_m
-from models.world import Warehouse, WarehouseSpec, generate_warehouse
+from models.sensing.lidar import cast_reference
+from models.sensing.raycast import StaticScene, cast_batch, scene_cell_m
+from models.world.warehouse import Warehouse, WarehouseSpec, generate_warehouse
 
 Result = dict[str, Any]
 

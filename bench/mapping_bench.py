@@ -18,10 +18,10 @@ import numpy as np
 import cosim
 from adapters.world.warehouse import scenario_warehouse
 from cosim.runner.execute import execute
-from models.lidar import ScanGeometry
 from models.mapping.grid import LogOddsMap, MapGeometry
 from models.mapping.matcher import MatcherParams, match, scan_points
-from models.raycast import StaticScene, cast_batch
+from models.sensing.lidar import ScanGeometry
+from models.sensing.raycast import StaticScene, cast_batch
 
 Result = dict[str, Any]
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "data"

@@ -28,7 +28,7 @@ from cosim.core.kernel import Kernel, Stage
 from cosim.core.messages import Message, Twist
 from cosim.core.registry import AdapterRegistry
 from cosim.runner.execute import execute
-from models.kinematics import FleetState
+from models.fleet.kinematics import FleetState
 
 Result = dict[str, Any]
 

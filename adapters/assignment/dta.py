@@ -68,11 +68,11 @@ from cosim.core.messages import (
 from cosim.core.recorder import TableSpec
 from cosim.core.timebase import period_ns, s_to_ns
 from models.assignment.problem import AssignmentProblem
-from models.kinematics import FleetState
+from models.fleet.kinematics import FleetState
 from models.navigation.costmap import StaticCostmap
 from models.navigation.planner import shortest_path_length_m
 from models.network.topology import diameter
-from models.world import Warehouse
+from models.world.warehouse import Warehouse
 
 
 class DtaAdapter:

@@ -25,7 +25,7 @@ from cosim.core.kernel import Stage
 from cosim.core.messages import Message, Twist
 from cosim.core.timebase import period_ns, s_to_ns
 from cosim.scenario.sections import RobotsConfig
-from models.kinematics import FleetState
+from models.fleet.kinematics import FleetState
 
 DEADMAN_S = 0.5
 """A robot with no command this long stops (s)."""

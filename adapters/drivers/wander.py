@@ -20,8 +20,8 @@ from cosim.core.kernel import Stage
 from cosim.core.messages import LaserScan, Message, Twist
 from cosim.core.timebase import period_ns
 from cosim.scenario.sections import LidarConfig, RobotsConfig
-from models.kinematics import FleetState
-from models.wander import WanderParams, wander
+from models.drivers.wander import WanderParams, wander
+from models.fleet.kinematics import FleetState
 
 
 class WanderAdapter:

@@ -26,9 +26,9 @@ from cosim.core.kernel import Stage
 from cosim.core.messages import Goal, Message, Odometry, Twist
 from cosim.core.timebase import period_ns, s_to_ns
 from cosim.scenario.sections import RobotsConfig
-from models.goto import GoToGains, go_to_goal
-from models.kinematics import FleetState
-from models.world import Warehouse
+from models.drivers.goto import GoToGains, go_to_goal
+from models.fleet.kinematics import FleetState
+from models.world.warehouse import Warehouse
 
 SIGHT_MARGIN_M = 0.15
 """Extra clearance around the straight path to a waypoint (m)."""

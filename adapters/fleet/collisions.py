@@ -22,10 +22,10 @@ from adapters.fleet.motion import FleetAdapter
 from cosim.core.adapter import RunContext
 from cosim.core.recorder import TableSpec
 from cosim.core.timebase import NS_PER_S
-from models.collision import CollisionChecker, OtherKind, Proximity
-from models.kinematics import FleetState, Motion
-from models.obstacles import DynamicObstacles
-from models.world import Warehouse
+from models.fleet.collision import CollisionChecker, OtherKind, Proximity
+from models.fleet.kinematics import FleetState, Motion
+from models.world.obstacles import DynamicObstacles
+from models.world.warehouse import Warehouse
 
 NEAR_MISS_M = 0.1
 """Clearance below which two things count as a near miss (m)."""

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from models.kinematics import FleetState, Motion, wrap_angle
+from models.fleet.kinematics import FleetState, Motion, wrap_angle
 
 
 class Mirrors:

@@ -26,9 +26,9 @@ from cosim.core.messages import Message, Odometry, Twist
 from cosim.core.rng import BlockDraws
 from cosim.core.timebase import NS_PER_S, period_ns
 from cosim.scenario.sections import OdometryConfig, RobotsConfig
-from models.kinematics import DriveLimits, FleetState, Motion
-from models.odometry import advance, drift_increments
-from models.world import Warehouse
+from models.fleet.kinematics import DriveLimits, FleetState, Motion
+from models.fleet.odometry import advance, drift_increments
+from models.world.warehouse import Warehouse
 
 MotionGuard = Callable[[int, Motion], None]
 """Called with (now in ns, proposed motion) before a step is committed; may hold robots."""

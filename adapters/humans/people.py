@@ -59,13 +59,13 @@ from cosim.scenario.fields import model_problem
 from cosim.scenario.sections import RobotsConfig, ScenarioSection
 from models.arrays import FloatArray
 from models.errors import ModelError
+from models.fleet.kinematics import FleetState
 from models.humans.aisles import AisleGraph, IntArray, aisle_graph, dock_points, pick_stations
 from models.humans.avoidance import free_distance, room, safe_step, speed_limit, step_aside
 from models.humans.bodies import push_out, two_disc_cover, vehicle_centres
 from models.humans.demand import Plan, plans, standing_plans
-from models.kinematics import FleetState
-from models.obstacles import DynamicObstacles
-from models.world import Warehouse
+from models.world.obstacles import DynamicObstacles
+from models.world.warehouse import Warehouse
 
 WAIT_MPS = 0.05
 """A walker the speed model limits below this is waiting for a robot (m/s)."""

@@ -31,7 +31,7 @@ from traci import constants as tc
 from adapters.humans.files import sumo_tool
 from cosim.core.errors import BridgeError
 from models.arrays import FloatArray
-from models.kinematics import wrap_angle
+from models.fleet.kinematics import wrap_angle
 
 SUMO_ERRORS: tuple[type[BaseException], ...] = (
     libsumo.TraCIException,

@@ -17,8 +17,8 @@ from adapters.tasks.source import TaskSourceAdapter
 from cosim.core.adapter import RunContext
 from cosim.core.recorder import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns
+from models.fleet.kinematics import FleetState
 from models.humans.encounters import HALT_MPS, Encounters
-from models.kinematics import FleetState
 from models.tasks.book import TaskStatus
 
 if TYPE_CHECKING:

@@ -25,11 +25,11 @@ from adapters.mapping.recording import (
     read_recording,
 )
 from cosim.core.errors import BagError
+from models.geometry.se2 import compose, relative
 from models.mapping.grid import MAX_CELLS, LogOddsMap, MapGeometry
 from models.mapping.loops import LoopCloser, LoopParams
 from models.mapping.matcher import MatcherParams
 from models.mapping.quality import align_se2, ate_rmse
-from models.mapping.se2 import compose, relative
 from models.mapping.slam import MapperParams, ScanMapper, UpdateGate
 
 MAP_REACH_M = 30.0

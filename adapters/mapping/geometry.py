@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from models.geometry.occupancy import UNKNOWN, OccupancyGrid
 from models.mapping.grid import MapGeometry
-from models.occupancy import UNKNOWN, OccupancyGrid
-from models.world import Warehouse
+from models.world.warehouse import Warehouse
 
 MARGIN_M = 1.0
 """The maps reach this far beyond the walls' outer faces (m)."""

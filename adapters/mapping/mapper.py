@@ -51,15 +51,15 @@ from cosim.core.timebase import period_ns, s_to_ns
 from cosim.scenario.sections import LidarConfig
 from models.arrays import FloatArray
 from models.errors import ModelError
-from models.kinematics import FleetState
-from models.lidar import ScanGeometry
+from models.fleet.kinematics import FleetState
+from models.geometry.occupancy import OccupancyGrid as Grid
 from models.mapping.exchange import PackedUpdate, pack, unpack
 from models.mapping.grid import LogOddsMap, Scratch, merged
 from models.mapping.loops import LoopParams
 from models.mapping.matcher import MatcherParams
 from models.mapping.slam import MapperParams, ScanMapper, UpdateGate
-from models.occupancy import OccupancyGrid as Grid
-from models.world import Warehouse
+from models.sensing.lidar import ScanGeometry
+from models.world.warehouse import Warehouse
 
 SCANS = "/fleet/mapping/scans"
 UPDATES = "/fleet/mapping/updates"

@@ -23,10 +23,10 @@ import numpy as np
 
 from cosim.core.recorder import Recorder, TableSpec
 from cosim.core.timebase import NS_PER_S
+from models.geometry.occupancy import OccupancyGrid, rasterize_boxes
 from models.mapping.grid import LogOddsMap, MapGeometry
 from models.mapping.quality import Int8Array, MapScores, map_scores, observable
-from models.occupancy import OccupancyGrid, rasterize_boxes
-from models.world import Warehouse
+from models.world.warehouse import Warehouse
 
 MAP_QUALITY = TableSpec(
     "map_quality",

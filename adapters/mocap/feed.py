@@ -28,7 +28,7 @@ from typing import IO, Any
 from adapters.mocap import feed_worker
 from adapters.mocap.settings import SYSTEMS
 from cosim.core.errors import BridgeError
-from models.mapping.se2 import yaw_of_quaternion
+from models.geometry.se2 import yaw_of_quaternion
 
 __all__ = ["SYSTEMS", "MotionCaptureFeed", "mock_bodies", "quaternion_yaw"]
 

@@ -30,7 +30,7 @@ from cosim.core.hosts import HostId
 from cosim.core.messages import PoseStamped
 from cosim.core.timebase import NS_PER_S
 from cosim.scenario.sections import RobotsConfig, WorldConfig
-from models.kinematics import FleetState
+from models.fleet.kinematics import FleetState
 from models.mocap.gate import PoseGate
 
 JUMP_TOLERANCE_RAD = 0.2

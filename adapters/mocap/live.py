@@ -23,7 +23,7 @@ from adapters.ros2dds.types import PoseStamped as DdsPoseStamped
 from adapters.ros2dds.types import planar_pose
 from cosim.core.adapter import RunContext
 from cosim.core.errors import BridgeError
-from models.kinematics import FleetState
+from models.fleet.kinematics import FleetState
 
 Sample = tuple[int, int, float, float, float]
 """(robot index, stamp in kernel ns, x_m, y_m, yaw_rad) in ``map``."""

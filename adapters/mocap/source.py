@@ -44,7 +44,7 @@ from cosim.core.kernel import Stage
 from cosim.core.recorder import TableSpec
 from cosim.core.rng import BlockDraws
 from cosim.core.timebase import ms_to_ns, period_ns, s_to_ns
-from models.kinematics import FleetState
+from models.fleet.kinematics import FleetState
 from models.mocap.sampling import MocapParams, measure
 
 MOCAP_HOST = "mocap"

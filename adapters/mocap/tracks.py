@@ -20,7 +20,7 @@ import numpy.typing as npt
 
 from cosim.core.bags import bag_info, read_messages
 from cosim.core.errors import BagError, CosimError
-from models.mapping.se2 import yaw_of_quaternion
+from models.geometry.se2 import yaw_of_quaternion
 from models.mocap.sampling import wrap_yaw
 
 POSE_TYPES = (

@@ -23,7 +23,7 @@ from cosim.core.adapter import RunContext
 from cosim.core.bus import Envelope
 from cosim.core.hosts import HostId
 from cosim.core.messages import Message, PoseStamped
-from models.kinematics import FleetState
+from models.fleet.kinematics import FleetState
 
 UNITY_PREFIX = "/unity"
 """Bus topics carrying Unity's poses: this prefix and the Unity-side topic (the Unity server

@@ -26,11 +26,11 @@ from adapters.navigation.layers import StaticLayers
 from cosim.core.adapter import RunContext
 from cosim.core.registry import Registry
 from models.arrays import BoolArray, FloatArray, IntArray, UInt8Array
-from models.kinematics import DriveLimits
+from models.fleet.kinematics import DriveLimits
+from models.geometry.occupancy import OccupancyGrid, ground_truth_grid
 from models.navigation.costmap import StaticCostmap
 from models.navigation.traffic import MovingPoints
-from models.occupancy import OccupancyGrid, ground_truth_grid
-from models.world import Warehouse
+from models.world.warehouse import Warehouse
 
 Route = tuple[FloatArray, float]
 """A path: (k, 2) waypoints in ``map`` (m), the last one the goal, and its length (m)."""

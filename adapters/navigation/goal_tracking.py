@@ -26,7 +26,7 @@ from cosim.core.hosts import HostId
 from cosim.core.messages import NavGoal, NavStatus
 from cosim.core.timebase import s_to_ns
 from models.arrays import BoolArray, FloatArray
-from models.kinematics import FleetState
+from models.fleet.kinematics import FleetState
 from models.navigation.costmap import StaticCostmap
 from models.navigation.follow import PathBook
 from models.navigation.planner import GoalStatus, goal_status

@@ -26,7 +26,7 @@ from cosim.core.hosts import HostId
 from cosim.core.messages import Message, NavGoal, NavStatus
 from cosim.core.timebase import s_to_ns
 from cosim.scenario.sections import RobotsConfig, WorldConfig
-from models.kinematics import FleetState
+from models.fleet.kinematics import FleetState
 from models.navigation.costmap import StaticCostmap
 
 GOAL_CLEARANCE_M = 0.3

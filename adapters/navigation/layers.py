@@ -19,9 +19,7 @@ from adapters.mapping.settings import MappingConfig
 from adapters.navigation.settings import NavigationConfig
 from cosim.core.adapter import RunContext
 from cosim.core.messages import OccupancyGrid as GridMessage
-from models.navigation.costmap import INSCRIBED, CostmapParams, StaticCostmap
-from models.navigation.lanes import TWO_WAY, aisle_lanes
-from models.occupancy import (
+from models.geometry.occupancy import (
     FREE,
     OCCUPIED,
     UNKNOWN,
@@ -30,7 +28,9 @@ from models.occupancy import (
     resample,
     resampled_obstacles,
 )
-from models.world import Warehouse
+from models.navigation.costmap import INSCRIBED, CostmapParams, StaticCostmap
+from models.navigation.lanes import TWO_WAY, aisle_lanes
+from models.world.warehouse import Warehouse
 
 
 class StaticLayer:

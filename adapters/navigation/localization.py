@@ -29,8 +29,8 @@ from cosim.core.hosts import HostId
 from cosim.core.messages import Message, Odometry, PoseStamped, TFMessage
 from cosim.core.timebase import NS_PER_S, ms_to_ns
 from models.arrays import FloatArray
-from models.kinematics import FleetState
-from models.mapping.se2 import compose
+from models.fleet.kinematics import FleetState
+from models.geometry.se2 import compose
 
 
 class MeasuredPoses:

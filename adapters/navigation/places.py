@@ -17,7 +17,7 @@ from scipy.optimize import linear_sum_assignment
 
 from models.arrays import BoolArray, FloatArray, IntArray, UInt8Array
 from models.errors import ModelError
-from models.kinematics import DriveLimits
+from models.fleet.kinematics import DriveLimits
 from models.navigation.costmap import StaticCostmap
 from models.navigation.place_drive import place_drive
 from models.navigation.roadmap import (

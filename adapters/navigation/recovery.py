@@ -17,7 +17,7 @@ import numpy as np
 from adapters.navigation.scan_memory import ScanMemory
 from cosim.core.timebase import s_to_ns
 from models.arrays import BoolArray, FloatArray
-from models.kinematics import DriveLimits
+from models.fleet.kinematics import DriveLimits
 
 RECOVERY_STEPS = (("wait", 1.0), ("rotate", 1.5), ("back_up", 1.5))
 """The recovery cycle: (behaviour, duration in s; the wait's is drawn), then a replan."""

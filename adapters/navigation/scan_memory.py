@@ -17,8 +17,8 @@ import numpy as np
 import numpy.typing as npt
 
 from models.arrays import FloatArray, IntArray
-from models.lidar import hits_within, seen_beyond
 from models.navigation.sightings import cell_keys, first_per_cell
+from models.sensing.lidar import hits_within, seen_beyond
 
 
 class ScanMemory:

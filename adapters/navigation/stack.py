@@ -65,8 +65,7 @@ from cosim.core.timebase import NS_PER_S, period_ns, s_to_ns
 from cosim.scenario.model import Scenario
 from cosim.scenario.sections import LidarConfig, RobotsConfig
 from models.arrays import BoolArray
-from models.kinematics import FleetState
-from models.lidar import ScanGeometry
+from models.fleet.kinematics import FleetState
 from models.navigation.dwa import DwaParams
 from models.navigation.follow import PathBook
 from models.navigation.place_drive import free_ahead
@@ -77,6 +76,7 @@ from models.navigation.traffic import (
     moving_points,
     speed_caps,
 )
+from models.sensing.lidar import ScanGeometry
 
 HALT_MPS = 0.02
 """Commanded speed below which a robot with a goal counts as halted (m/s)..."""

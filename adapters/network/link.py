@@ -26,7 +26,7 @@ from cosim.core.kernel import Stage
 from cosim.core.link import AllDelivered, DeliveryStatus, Transfer
 from cosim.core.recorder import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns
-from models.kinematics import FleetState
+from models.fleet.kinematics import FleetState
 from models.network.fate import Fate
 from models.network.model import NetworkModel, Partition
 from models.network.topology import Edges, edge

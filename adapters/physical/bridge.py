@@ -49,7 +49,7 @@ from cosim.core.messages import LaserScan, Message, PoseStamped, Twist
 from cosim.core.messages.navigation import NavGoal
 from cosim.core.recorder import Recorder
 from cosim.core.timebase import NS_PER_S, period_ns, s_to_ns
-from models.kinematics import FleetState
+from models.fleet.kinematics import FleetState
 
 WATCH_HZ = 4.0
 """Rate at which the physical robots' poses are checked for silence (Hz)."""

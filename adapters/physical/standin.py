@@ -2,7 +2,7 @@
 
 It behaves like a real differential-drive robot seen through ROS 2: it obeys
 ``/<name>/cmd_vel`` (geometry_msgs/Twist in ``base_link``, with the drive limits of
-:mod:`models.kinematics` and a twist watchdog), reports its pose in ``map`` on
+:mod:`models.fleet.kinematics` and a twist watchdog), reports its pose in ``map`` on
 ``/<name>/pose`` as a motion-capture system would (optionally late and noisy), its
 wheel odometry on ``/<name>/odom`` (``<name>/odom`` -> ``<name>/base_link``, REP 105,
 the odom frame being its start pose) and counts the scans sent to ``/<name>/scan``.
@@ -47,7 +47,7 @@ from adapters.ros2dds.types import (
 )
 from cosim.core.errors import ConfigError, CosimError
 from models.arrays import FloatArray
-from models.kinematics import DriveLimits, FleetState
+from models.fleet.kinematics import DriveLimits, FleetState
 
 RADIUS_M = 0.33
 """Footprint radius of the stand-in (m, a Jackal's); it never collides with anything."""

@@ -15,7 +15,7 @@ from cosim.core.kernel import Stage
 from cosim.core.recorder import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns
 from cosim.scenario.sections import RecordConfig
-from models.kinematics import FleetState
+from models.fleet.kinematics import FleetState
 
 POSES = TableSpec(
     "poses",

@@ -53,9 +53,9 @@ from cosim.core.messages import (
 )
 from cosim.core.messages.scene import RGBA, MarkerAction
 from cosim.scenario.sections import RobotsConfig
-from models.kinematics import FleetState
-from models.occupancy import ground_truth_grid
-from models.world import Warehouse
+from models.fleet.kinematics import FleetState
+from models.geometry.occupancy import ground_truth_grid
+from models.world.warehouse import Warehouse
 
 MAP_RESOLUTION_M = 0.05
 """Cell size of ``/map`` (m), map_server's usual resolution."""

@@ -19,7 +19,7 @@ from cyclonedds.idl import IdlStruct
 from cyclonedds.idl import types as idl
 from cyclonedds.idl.annotations import final
 
-from models.mapping.se2 import yaw_of_quaternion
+from models.geometry.se2 import yaw_of_quaternion
 
 Covariance = Annotated[Sequence[idl.float64], idl.array(idl.float64, 36)]
 """Row-major 6x6 covariance over (x, y, z, rot x, rot y, rot z)."""

@@ -2,7 +2,7 @@
 
 At ``lidar.rate_hz`` (SENSING stage) it casts all robots' beams against the static
 world, the other robots and the dynamic obstacles in one call (a grid-indexed caster,
-:mod:`models.raycast`), applies each robot's noise and dropout from the robot's own
+:mod:`models.sensing.raycast`), applies each robot's noise and dropout from the robot's own
 random stream, and publishes ``/<robot>/scan`` on the robot's host.
 """
 
@@ -23,11 +23,11 @@ from cosim.core.messages import LaserScan
 from cosim.core.rng import BlockDraws
 from cosim.core.timebase import period_ns
 from cosim.scenario.sections import LidarConfig
-from models.kinematics import FleetState
-from models.lidar import ScanGeometry, apply_sensor_model
-from models.obstacles import DynamicObstacles
-from models.raycast import StaticScene, cast_batch, scene_cell_m
-from models.world import Warehouse
+from models.fleet.kinematics import FleetState
+from models.sensing.lidar import ScanGeometry, apply_sensor_model
+from models.sensing.raycast import StaticScene, cast_batch, scene_cell_m
+from models.world.obstacles import DynamicObstacles
+from models.world.warehouse import Warehouse
 
 
 class LidarAdapter:

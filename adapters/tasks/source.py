@@ -55,11 +55,11 @@ from cosim.core.messages import (
 from cosim.core.recorder import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns, s_to_ns
 from cosim.scenario.sections import RobotsConfig, WorldConfig
-from models.kinematics import FleetState
+from models.fleet.kinematics import FleetState
 from models.navigation.costmap import INSCRIBED, StaticCostmap
 from models.tasks.book import ClaimOutcome, TaskBook, TaskStatus
 from models.tasks.stations import pick_stations
-from models.world import Warehouse
+from models.world.warehouse import Warehouse
 
 TASKS_TABLE = TableSpec(
     "tasks",

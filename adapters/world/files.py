@@ -32,8 +32,8 @@ import yaml
 
 from cosim.core.errors import ConfigError, ExportError
 from models.errors import ModelError
-from models.occupancy import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
-from models.world import Warehouse
+from models.geometry.occupancy import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from models.world.warehouse import Warehouse
 
 OCCUPIED_PIXEL = 0
 """PGM value of an occupied cell (black)."""

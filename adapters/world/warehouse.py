@@ -13,9 +13,9 @@ from cosim.core.rng import RngStreams
 from cosim.scenario.fields import model_problem
 from cosim.scenario.sections import RobotsConfig, WorldConfig
 from models.errors import ModelError
-from models.layout import WarehouseSpec
-from models.obstacles import DynamicObstacles
-from models.world import Warehouse, generate_warehouse
+from models.world.layout import WarehouseSpec
+from models.world.obstacles import DynamicObstacles
+from models.world.warehouse import Warehouse, generate_warehouse
 
 WORLD_STREAM = "world"
 """The random stream a scenario's warehouse is generated from."""

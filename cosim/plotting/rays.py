@@ -1,7 +1,7 @@
 """One robot's lidar beams, recomputed from the run's world and poses.
 
 The run does not store its scans; they are cast again with the project's batched caster
-(:func:`models.raycast.cast_batch`, as :mod:`adapters.sensing.lidar` calls it) against the
+(:func:`models.sensing.raycast.cast_batch`, as :mod:`adapters.sensing.lidar` calls it) against the
 static world, the other robots and the people (``tables/humans``, the latest sample at
 or before the pose) at each pose sample: the exact ranges, before the sensor model's
 noise and dropout.
@@ -16,8 +16,8 @@ import numpy as np
 from cosim.plotting.people import PeopleSamples
 from cosim.plotting.rundata import RunData
 from models.arrays import BoolArray, FloatArray
-from models.lidar import ScanGeometry
-from models.raycast import StaticScene, cast_batch, scene_cell_m
+from models.sensing.lidar import ScanGeometry
+from models.sensing.raycast import StaticScene, cast_batch, scene_cell_m
 
 
 class LidarRays:

@@ -21,7 +21,7 @@ from cosim.plotting.canvas import robot_order
 from cosim.plotting.ownership import task_holds
 from cosim.scenario import Scenario, load_scenario
 from models.arrays import FloatArray
-from models.world import Warehouse
+from models.world.warehouse import Warehouse
 
 SCENARIO_FILE = "scenario.toml"
 TABLES_DIR = "tables"

@@ -17,7 +17,7 @@ from matplotlib.patches import Circle, Patch, Rectangle
 from adapters.naming import robot_name
 from cosim.plotting.canvas import save_png
 from models.arrays import FloatArray
-from models.world import Warehouse, WarehouseSpec
+from models.world.warehouse import Warehouse, WarehouseSpec
 
 WALL_COLOR = "0.3"
 SHELF_COLOR = "#c8864a"

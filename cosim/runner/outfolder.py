@@ -27,7 +27,7 @@ from adapters.world.files import write_map
 from cosim.core.errors import ExportError
 from cosim.recording.bag import BAG_DIR
 from cosim.scenario.loader import dump_scenario
-from models.occupancy import OccupancyGrid
+from models.geometry.occupancy import OccupancyGrid
 
 if TYPE_CHECKING:
     from cosim.runner.execute import RunResult

@@ -21,7 +21,7 @@ from scipy.sparse.csgraph import connected_components
 
 from models.arrays import FloatArray
 from models.errors import ModelError
-from models.world import Warehouse, box_distance
+from models.world.warehouse import Warehouse, box_distance
 
 SAMPLE_M = 0.1
 """Spacing of the points at which an edge's clearance is checked (m)."""

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from models.arrays import FloatArray
-from models.world import box_distance
+from models.world.warehouse import box_distance
 
 
 def vehicle_centres(

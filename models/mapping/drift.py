@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from models.arrays import FloatArray
-from models.mapping.se2 import compose, relative
+from models.geometry.se2 import compose, relative
 
 
 @dataclass(frozen=True)

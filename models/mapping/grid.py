@@ -18,7 +18,7 @@ whose lower-left corner is that cell, an upper bound for branch and bound. Both 
 up to date cell by cell as cells become occupied or stop being so, never rebuilt.
 
 Frame ``map``; arrays are indexed ``[iy, ix]`` with row 0 at the lowest y, as
-:class:`models.occupancy.OccupancyGrid`.
+:class:`models.geometry.occupancy.OccupancyGrid`.
 """
 
 from __future__ import annotations
@@ -31,8 +31,8 @@ import numpy.typing as npt
 
 from models.arrays import FloatArray
 from models.errors import ModelError
+from models.geometry.occupancy import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from models.mapping.kernels import apply, classify, rebuild_scores, refresh_scores, traverse
-from models.occupancy import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 
 COARSE = 4
 """Cells per side of the coarse score's window (the matcher's first level)."""
@@ -333,7 +333,7 @@ class LogOddsMap:
         return cells
 
     def occupancy_grid(self) -> OccupancyGrid:
-        """The map as a :class:`models.occupancy.OccupancyGrid`."""
+        """The map as a :class:`models.geometry.occupancy.OccupancyGrid`."""
         g = self.geometry
         return OccupancyGrid(g.resolution_m, g.origin_xy_m, self.occupancy())
 

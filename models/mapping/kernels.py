@@ -12,7 +12,7 @@ from typing import Any
 
 import numba
 
-from models.occupancy import FREE, OCCUPIED, UNKNOWN
+from models.geometry.occupancy import FREE, OCCUPIED, UNKNOWN
 
 
 def _traverse_py(

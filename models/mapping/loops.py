@@ -35,10 +35,10 @@ import numpy.typing as npt
 from scipy.stats import chi2 as chi_square
 
 from models.arrays import FloatArray
+from models.geometry.se2 import Pose, compose, relative
 from models.mapping.grid import LogOddsMap, MapGeometry
 from models.mapping.matcher import MatcherParams, match, scan_points
 from models.mapping.posegraph import Edge, PoseGraph, sqrt_information
-from models.mapping.se2 import Pose, compose, relative
 from models.mapping.uncertainty import ResponseWindow, match_covariance
 
 

@@ -23,7 +23,7 @@ from scipy.sparse import csr_matrix, diags
 from scipy.sparse.linalg import spsolve
 
 from models.arrays import FloatArray
-from models.mapping.se2 import Pose, wrap
+from models.geometry.se2 import Pose, wrap
 
 
 class Edge(NamedTuple):

@@ -28,7 +28,7 @@ import numpy as np
 import numpy.typing as npt
 
 from models.arrays import FloatArray
-from models.occupancy import FREE, OCCUPIED, UNKNOWN
+from models.geometry.occupancy import FREE, OCCUPIED, UNKNOWN
 
 Int8Array = npt.NDArray[np.int8]
 BoolArray = npt.NDArray[np.bool_]

@@ -21,10 +21,10 @@ import numpy.typing as npt
 
 from models.arrays import FloatArray
 from models.errors import ModelError
+from models.geometry.se2 import Pose, compose, inverse, relative
 from models.mapping.grid import LogOddsMap
 from models.mapping.loops import LoopCloser, LoopParams
 from models.mapping.matcher import MatcherParams, match, scan_points
-from models.mapping.se2 import Pose, compose, inverse, relative
 from models.mapping.uncertainty import match_covariance
 
 

@@ -19,8 +19,8 @@ import numba
 import numpy as np
 
 from models.arrays import FloatArray
+from models.geometry.se2 import Pose
 from models.mapping.grid import LogOddsMap
-from models.mapping.se2 import Pose
 
 
 @dataclass(frozen=True)

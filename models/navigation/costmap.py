@@ -16,7 +16,7 @@ Cost values and the inflation rule are those of Nav2's ``nav2_costmap_2d``
 centre, as Nav2 measures it. The radii are compared with a 1 nm tolerance so that a cell
 lying exactly on a radius counts as inside despite binary rounding (7 * 0.05 > 0.35).
 
-The static layer is built once from any :class:`models.occupancy.OccupancyGrid` (today the
+The static layer is built once from any :class:`models.geometry.occupancy.OccupancyGrid` (today the
 ground-truth map, later a SLAM map); dynamic obstacles (lidar hits, other robots) are
 stamped on a copy of it for each plan, as Nav2's obstacle layer does, by taking the
 maximum with a precomputed inflation kernel. Grids are indexed ``[iy, ix]`` with row 0
@@ -34,6 +34,7 @@ import numpy.typing as npt
 
 from models.arrays import FloatArray, IntArray, UInt8Array
 from models.errors import ModelError
+from models.geometry.occupancy import OccupancyGrid
 from models.navigation.cost_kernels import (
     _RADIUS_TOL_M,
     FREE,
@@ -47,7 +48,6 @@ from models.navigation.cost_kernels import (
     _stamp_discs,
     _stamp_points,
 )
-from models.occupancy import OccupancyGrid
 
 
 @dataclass(frozen=True)

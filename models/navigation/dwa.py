@@ -16,7 +16,7 @@ and call (poses and points in ``map``, velocities in ``base_link``):
   facing away from its carrot turns on the spot instead of driving a wide loop.
   ``v_samples x w_samples`` samples span the window; the ``w`` nearest 0 snaps to 0.
 - **Trajectories.** Each ``(v, w)`` is held for ``sim_time_s`` and evaluated at
-  ``sim_steps`` points on the exact arc of :func:`models.kinematics.integrate` (chord
+  ``sim_steps`` points on the exact arc of :func:`models.fleet.kinematics.integrate` (chord
   ``v t sinc(w t / 2)`` along the mid heading). A point's clearance is its distance to
   the nearest obstacle point or disc edge minus the footprint radius; a trajectory's
   clearance is the minimum over its points.
@@ -67,7 +67,7 @@ import numpy as np
 
 from models.arrays import BoolArray, FloatArray, IntArray
 from models.errors import ModelError
-from models.kinematics import DriveLimits
+from models.fleet.kinematics import DriveLimits
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,7 @@ import numba
 import numpy as np
 
 from models.arrays import FloatArray, IntArray
-from models.kinematics import DriveLimits, wrap_angle
+from models.fleet.kinematics import DriveLimits, wrap_angle
 
 TURN_FIRST_RAD = 0.3
 """Heading error above which a robot turns on the spot before driving (rad)."""

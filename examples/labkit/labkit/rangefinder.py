@@ -26,10 +26,10 @@ from cosim.core.messages import Message
 from cosim.core.recorder import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns
 from cosim.scenario.fields import param
-from models.kinematics import FleetState
-from models.obstacles import DynamicObstacles
-from models.raycast import StaticScene, cast_batch, scene_cell_m
-from models.world import Warehouse
+from models.fleet.kinematics import FleetState
+from models.sensing.raycast import StaticScene, cast_batch, scene_cell_m
+from models.world.obstacles import DynamicObstacles
+from models.world.warehouse import Warehouse
 
 ULTRASOUND = 0
 """``sensor_msgs/Range.radiation_type`` of an ultrasonic sensor."""

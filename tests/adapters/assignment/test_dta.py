@@ -15,8 +15,8 @@ from cosim.core.registry import AdapterRegistry
 from cosim.core.timebase import s_to_ns
 from cosim.runner.assembly import adapter_names
 from cosim.runner.execute import execute
-from models.kinematics import FleetState
-from models.obstacles import DynamicObstacles
+from models.fleet.kinematics import FleetState
+from models.world.obstacles import DynamicObstacles
 
 BASE = {
     "scenario.duration_s": 150.0,

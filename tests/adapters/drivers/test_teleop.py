@@ -13,7 +13,7 @@ from cosim.core.messages import Twist
 from cosim.core.timebase import s_to_ns
 from cosim.runner.assembly import Assembly, assemble
 from cosim.scenario.sections import RobotsConfig
-from models.kinematics import FleetState
+from models.fleet.kinematics import FleetState
 
 
 def _teleop_lab_room() -> Assembly:

@@ -12,8 +12,8 @@ from cosim.core.kernel import Stage
 from cosim.core.messages import Twist
 from cosim.core.registry import AdapterRegistry
 from cosim.runner.execute import execute
-from models.kinematics import FleetState
-from models.obstacles import DynamicObstacles
+from models.fleet.kinematics import FleetState
+from models.world.obstacles import DynamicObstacles
 
 
 class DriveStraight:

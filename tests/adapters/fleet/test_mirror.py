@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from adapters.fleet.mirror import Mirrors
-from models.kinematics import DriveLimits, FleetState
+from models.fleet.kinematics import DriveLimits, FleetState
 
 LIMITS = DriveLimits(1.0, 0.3, 2.0, 2.0, 3.0)
 

@@ -22,8 +22,8 @@ from cosim.core.adapter import RunContext
 from cosim.core.messages import LaserScan, Message
 from cosim.core.registry import AdapterRegistry
 from cosim.runner.execute import execute, run
-from models.kinematics import FleetState
-from models.world import box_distance
+from models.fleet.kinematics import FleetState
+from models.world.warehouse import box_distance
 
 pytestmark = pytest.mark.slow
 

@@ -121,8 +121,8 @@ def test_loop_closure_with_shared_map_updates_is_refused_naming_the_keys():
 @pytest.mark.slow
 def test_with_a_robots_layer_the_other_robots_stay_out_of_the_maps():
     from adapters.world.warehouse import scenario_warehouse
+    from models.geometry.occupancy import rasterize_boxes
     from models.mapping.quality import dilate
-    from models.occupancy import rasterize_boxes
 
     phantoms = {}
     for layer in (False, True):

@@ -13,7 +13,7 @@ from cosim.core.timebase import s_to_ns
 from cosim.recording.schemas import channel_specs
 from cosim.recording.unity import UnityOptions, UnitySink
 from cosim.runner.assembly import assemble
-from models.kinematics import FleetState
+from models.fleet.kinematics import FleetState
 from tests.cosim.recording.connector import Connector, goal_pose_cdr
 
 UNITY = {"mocap.source": "unity", "mocap.bodies": [["robot_1", "/robot_1/pose"]]}

@@ -13,10 +13,10 @@ from adapters.navigation.fleet_traffic import FleetTraffic
 from adapters.navigation.places import CLEARANCE_M, MOVE, STAND, FleetPlaces
 from cosim.runner.assembly import check_scenario
 from models.errors import ModelError
+from models.geometry.occupancy import OccupancyGrid
 from models.navigation.costmap import CostmapParams, StaticCostmap
 from models.navigation.lanes import TWO_WAY
 from models.navigation.roadmap import build_roadmap
-from models.occupancy import OccupancyGrid
 
 
 def _pibt_fleet(count: int, duration_s: float) -> cosim.Scenario:

@@ -3,9 +3,9 @@ import pytest
 
 from adapters.navigation.layers import StaticLayers, _traversable, open_goal, padded
 from cosim.core.messages import OccupancyGrid as GridMessage
+from models.geometry.occupancy import FREE, OCCUPIED, UNKNOWN, OccupancyGrid, resample
 from models.navigation.costmap import INSCRIBED, CostmapParams, StaticCostmap
 from models.navigation.planner import plan
-from models.occupancy import FREE, OCCUPIED, UNKNOWN, OccupancyGrid, resample
 
 PARAMS = CostmapParams(robot_radius_m=0.33, inflation_radius_m=1.0, cost_scaling=3.0)
 ORIGIN = (-1.0, -2.0)

@@ -15,10 +15,10 @@ from cosim.core.messages import Message, NavGoal, NavStatus
 from cosim.core.registry import AdapterRegistry
 from cosim.core.timebase import s_to_ns
 from cosim.runner.execute import execute
-from models.kinematics import FleetState
+from models.fleet.kinematics import FleetState
 from models.navigation.costmap import StaticCostmap
 from models.navigation.planner import shortest_path_length_m
-from models.obstacles import DynamicObstacles
+from models.world.obstacles import DynamicObstacles
 
 
 class GoalScript:
@@ -285,9 +285,9 @@ def test_robots_that_map_drive_on_the_buildings_lanes_laid_into_their_wider_maps
     from adapters.navigation.layers import lanes_on
     from adapters.navigation.traffic_policies import LANE_WIDTH_M
     from adapters.world.warehouse import scenario_warehouse
+    from models.geometry.occupancy import OCCUPIED, OccupancyGrid, ground_truth_grid
     from models.navigation.costmap import CostmapParams, StaticCostmap
     from models.navigation.lanes import TWO_WAY, aisle_lanes
-    from models.occupancy import OCCUPIED, OccupancyGrid, ground_truth_grid
 
     scenario = cosim.load_scenario("warehouse-mapping", {"navigation.traffic": "lanes"})
     truth = ground_truth_grid(scenario_warehouse(scenario), 0.1)

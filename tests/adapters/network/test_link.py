@@ -19,7 +19,7 @@ from cosim.core.messages import Message
 from cosim.core.registry import AdapterRegistry
 from cosim.core.rng import RngStreams
 from cosim.runner.execute import execute
-from models.kinematics import FleetState
+from models.fleet.kinematics import FleetState
 from models.network import ConstantLatency, LinkParams, NetworkModel, NoLoss
 from models.network.topology import complete
 

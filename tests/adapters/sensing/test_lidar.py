@@ -10,7 +10,7 @@ from cosim.core.hosts import HostId
 from cosim.core.messages import LaserScan
 from cosim.core.registry import AdapterRegistry
 from cosim.runner.execute import execute
-from models.obstacles import DynamicObstacles
+from models.world.obstacles import DynamicObstacles
 
 SCENARIO = {
     "scenario.duration_s": 0.35,

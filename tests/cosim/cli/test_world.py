@@ -11,8 +11,8 @@ from adapters.world.warehouse import scenario_warehouse
 from cosim.cli.world import world_command
 from cosim.core.errors import ConfigError, ScenarioError
 from cosim.runner.assembly import assemble
-from models.occupancy import ground_truth_grid
-from models.world import Warehouse
+from models.geometry.occupancy import ground_truth_grid
+from models.world.warehouse import Warehouse
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 

@@ -173,7 +173,7 @@ def test_a_snapshot_shows_everyone_at_the_latest_sample_before_its_time(people_r
 def test_the_redrawn_lidar_beams_stop_at_people_as_the_run_s_lidar_did(people_run):
     from cosim.plotting.people import PeopleSamples
     from cosim.plotting.rays import LidarRays
-    from models.kinematics import wrap_angle
+    from models.fleet.kinematics import wrap_angle
 
     samples = PeopleSamples(people_run)
     track = people_run.track

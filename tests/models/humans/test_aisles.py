@@ -7,8 +7,8 @@ import cosim
 from adapters.world.warehouse import scenario_warehouse
 from models.errors import ModelError
 from models.humans.aisles import SAMPLE_M, aisle_graph, dock_points, pick_stations
-from models.layout import WarehouseSpec
-from models.world import box_distance, generate_warehouse
+from models.world.layout import WarehouseSpec
+from models.world.warehouse import box_distance, generate_warehouse
 
 
 def _world(preset, **overrides):

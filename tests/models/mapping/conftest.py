@@ -7,10 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from models.lidar import ScanGeometry
 from models.mapping.grid import LogOddsMap, MapGeometry
-from models.raycast import StaticScene, cast_batch
-from models.world import box_segments
+from models.sensing.lidar import ScanGeometry
+from models.sensing.raycast import StaticScene, cast_batch
+from models.world.warehouse import box_segments
 
 ROOM = np.array(
     [

@@ -5,9 +5,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from models.geometry.occupancy import FREE, OCCUPIED, UNKNOWN
 from models.mapping.grid import COARSE, LogOddsMap, LogOddsParams, MapGeometry, merged
 from models.mapping.kernels import rebuild_scores
-from models.occupancy import FREE, OCCUPIED, UNKNOWN
 from tests.models.mapping.conftest import GEOMETRY, ROOM, Lidar, integrate, room_map
 
 POSE = (6.0, 3.0, 0.3)

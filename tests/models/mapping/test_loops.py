@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
+from models.geometry.se2 import compose, relative
 from models.mapping.loops import LoopCloser, LoopParams
 from models.mapping.posegraph import Edge, sqrt_information
-from models.mapping.se2 import compose, relative
 
 ANGLES = np.linspace(-math.pi, math.pi, 8, endpoint=False)
 MATCHED = np.diag([0.02**2, 0.02**2, 0.005**2])  # a scan match's covariance

@@ -3,8 +3,8 @@ import math
 import numpy as np
 import pytest
 
+from models.geometry.se2 import compose, relative
 from models.mapping.posegraph import Edge, PoseGraph, sqrt_information
-from models.mapping.se2 import compose, relative
 
 
 def _square(drift: float) -> tuple[PoseGraph, list]:

@@ -3,8 +3,8 @@ import math
 import numpy as np
 import pytest
 
+from models.geometry.occupancy import FREE, OCCUPIED, UNKNOWN
 from models.mapping.quality import align_se2, ate_rmse, dilate, map_scores, observable
-from models.occupancy import FREE, OCCUPIED, UNKNOWN
 
 
 def _room() -> tuple[np.ndarray, np.ndarray]:

@@ -3,9 +3,9 @@ import math
 import numpy as np
 import pytest
 
+from models.geometry.se2 import compose, inverse, relative
 from models.mapping.grid import LogOddsMap, MapGeometry
 from models.mapping.loops import LoopParams
-from models.mapping.se2 import compose, inverse, relative
 from models.mapping.slam import MapperParams, ScanMapper, UpdateGate
 from tests.models.mapping.conftest import GEOMETRY, Lidar
 

@@ -6,6 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from models.errors import ModelError
+from models.geometry.occupancy import OCCUPIED, UNKNOWN, OccupancyGrid
 from models.navigation.costmap import (
     INSCRIBED,
     LETHAL,
@@ -16,7 +17,6 @@ from models.navigation.costmap import (
     stamp_discs,
     with_obstacles,
 )
-from models.occupancy import OCCUPIED, UNKNOWN, OccupancyGrid
 
 RES = 0.05
 PARAMS = CostmapParams(robot_radius_m=0.3, inflation_radius_m=1.0, cost_scaling=3.0)

@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 
 from models.errors import ModelError
-from models.kinematics import DriveLimits, FleetState, integrate, wrap_angle
+from models.fleet.kinematics import DriveLimits, FleetState, integrate, wrap_angle
 from models.navigation.dwa import DwaParams, dwa_batch
-from models.raycast import StaticScene, cast_batch
-from models.world import WarehouseSpec, generate_warehouse
+from models.sensing.raycast import StaticScene, cast_batch
+from models.world.warehouse import WarehouseSpec, generate_warehouse
 
 LIMITS = DriveLimits(1.0, 0.3, 2.0, 2.0, 3.0)
 RADIUS = 0.33

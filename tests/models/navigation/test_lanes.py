@@ -2,10 +2,10 @@ import numpy as np
 import pytest
 
 from models.errors import ModelError
+from models.geometry.occupancy import OCCUPIED, OccupancyGrid
 from models.navigation.costmap import CostmapParams, StaticCostmap
 from models.navigation.lanes import EAST, NORTH, SOUTH, TWO_WAY, WEST, aisle_lanes
 from models.navigation.planner import plan
-from models.occupancy import OCCUPIED, OccupancyGrid
 
 RES = 0.1
 

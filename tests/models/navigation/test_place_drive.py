@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from models.kinematics import DriveLimits
+from models.fleet.kinematics import DriveLimits
 from models.navigation.place_drive import STOP_MARGIN_M, THERE_M, free_ahead, place_drive
 
 LIMITS = DriveLimits(1.0, 0.3, 2.0, 2.0, 3.0)

@@ -6,10 +6,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from models.errors import ModelError
+from models.geometry.occupancy import OCCUPIED, OccupancyGrid
 from models.navigation.costmap import INSCRIBED, CostmapParams, StaticCostmap, with_obstacles
 from models.navigation.planner import path_to_world, plan, prune_path
 from models.navigation.repair import RepairParams, repair_path, split_ahead
-from models.occupancy import OCCUPIED, OccupancyGrid
 
 RES = 0.1
 PARAMS = CostmapParams(robot_radius_m=0.2, inflation_radius_m=0.6)

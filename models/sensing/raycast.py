@@ -1,6 +1,6 @@
 """Fast exact 2D lidar ray casting for whole fleets, one core, compiled with numba.
 
-Every beam reports what :func:`models.lidar.cast_reference` reports: the nearest
+Every beam reports what :func:`models.sensing.lidar.cast_reference` reports: the nearest
 segment hit with ``t >= 0`` and ``u`` in ``[0, 1]``, the near root of a circle hit from
 outside, the exit root from inside, never the origin's own circle, and ``inf`` beyond
 ``range_max``. The intersection arithmetic is the reference's, term by term, and the
@@ -178,7 +178,7 @@ def _cast_py(
         own = exclude[r]
         c_yaw, s_yaw = cos_yaw[r], sin_yaw[r]
         for b in range(cos_beam.shape[0]):
-            # exactly the products and sums of models.lidar.beam_directions
+            # exactly the products and sums of models.sensing.lidar.beam_directions
             dx = c_yaw * cos_beam[b] - s_yaw * sin_beam[b]
             dy = s_yaw * cos_beam[b] + c_yaw * sin_beam[b]
             best = inf
@@ -351,7 +351,7 @@ def cast_batch(
     exclude: IntArray,
     range_max_m: float,
 ) -> FloatArray:
-    """Exact ranges of every beam of every sensor, as :func:`models.lidar.cast_reference`.
+    """Exact ranges of every beam of every sensor, as :func:`models.sensing.lidar.cast_reference`.
 
     Args:
         scene: the static segments, binned.
@@ -374,7 +374,7 @@ def cast_batch(
     start, data, ids, spill, spill_ids = _bin_circles(circ, scene.grid)
     out = np.empty((len(org), len(beams)), dtype=np.float64)
     # numpy's cos/sin of r + b angles; the kernel forms the directions from them exactly
-    # as models.lidar.beam_directions does
+    # as models.sensing.lidar.beam_directions does
     _cast(
         org,
         np.cos(yaw),

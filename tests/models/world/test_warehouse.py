@@ -6,7 +6,7 @@ import shapely
 from shapely.geometry import box
 
 from models.errors import ModelError
-from models.world import WarehouseSpec, box_distance, generate_warehouse
+from models.world.warehouse import WarehouseSpec, box_distance, generate_warehouse
 
 
 def _gen(**kwargs):

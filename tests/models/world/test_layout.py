@@ -8,8 +8,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from models.errors import ModelError
-from models.layout import box_gaps
-from models.world import WarehouseSpec, generate_warehouse
+from models.world.layout import box_gaps
+from models.world.warehouse import WarehouseSpec, generate_warehouse
 
 
 def _world(**kw):

@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from shapely.geometry import Point, box
 
-from models.collision import CollisionChecker, OtherKind, disc_box_clearance
+from models.fleet.collision import CollisionChecker, OtherKind, disc_box_clearance
 
 BOXES = np.array([[2.0, 2.0, 4.0, 3.0], [6.0, 0.0, 6.5, 8.0]])
 
@@ -113,7 +113,7 @@ def test_empty_candidate_groups_give_empty_clearances():
 
 def _fcl_robot_pairs(checker: CollisionChecker, x, y) -> set[tuple[int, int]]:
     """The robot pairs of FCL's own self-collision of the grown discs (the reference)."""
-    from models import collision
+    from models.fleet import collision
 
     checker._place_robots(x, y)
     found: list[object] = []

@@ -13,7 +13,7 @@ import numpy as np
 import numpy.typing as npt
 
 from models.arrays import FloatArray
-from models.kinematics import wrap_angle
+from models.fleet.kinematics import wrap_angle
 
 
 @dataclass(frozen=True)

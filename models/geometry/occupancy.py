@@ -19,7 +19,7 @@ from models.arrays import FloatArray, IntArray
 from models.errors import ModelError
 
 if TYPE_CHECKING:
-    from models.world import Warehouse
+    from models.world.warehouse import Warehouse
 
 FREE = 0
 """Cell value of a free cell (ROS convention)."""
@@ -189,7 +189,7 @@ def ground_truth_grid(warehouse: Warehouse, resolution_m: float) -> OccupancyGri
         resolution_m: cell edge length (m/cell).
 
     Returns:
-        A grid covering :attr:`models.world.Warehouse.bounds` (walls included) with every
+        A grid covering :attr:`models.world.warehouse.Warehouse.bounds` (walls included) with every
         cell free or occupied; robots are not obstacles.
     """
     return rasterize_boxes(warehouse.boxes, warehouse.bounds, resolution_m)

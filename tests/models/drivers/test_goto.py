@@ -2,8 +2,8 @@ import math
 
 import numpy as np
 
-from models.goto import GoToGains, go_to_goal
-from models.kinematics import DriveLimits, FleetState
+from models.drivers.goto import GoToGains, go_to_goal
+from models.fleet.kinematics import DriveLimits, FleetState
 
 
 def test_the_controller_turns_in_place_before_driving_to_a_goal_behind():

@@ -21,7 +21,7 @@ import numpy as np
 import numpy.typing as npt
 
 from models.arrays import FloatArray
-from models.kinematics import integrate_fleet
+from models.fleet.kinematics import integrate_fleet
 
 
 def drift_increments(
@@ -56,7 +56,7 @@ def advance(
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Integrate measured increments into odometry poses (frame ``odom``), as an exact arc.
 
-    :func:`models.kinematics.integrate` over a step of 1 (the increments are the step's).
+    :func:`models.fleet.kinematics.integrate` over a step of 1 (the increments are the step's).
     """
     f64 = np.float64
     return integrate_fleet(

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from models.odometry import advance, drift_increments
+from models.fleet.odometry import advance, drift_increments
 
 
 def test_zero_drift_leaves_the_increments_unchanged():

@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from models.kinematics import (
+from models.fleet.kinematics import (
     DriveLimits,
     FleetState,
     integrate,

@@ -1,6 +1,6 @@
 """The warehouse world: walls, shelves and robot start poses (frame ``map``).
 
-``WarehouseSpec`` and the shelf layouts live in :mod:`models.layout`.
+``WarehouseSpec`` and the shelf layouts live in :mod:`models.world.layout`.
 
 The inner room spans ``[0, size_x] x [0, size_y]`` metres; the walls lie outside it. All
 obstacles are axis-aligned boxes ``(xmin, ymin, xmax, ymax)``: shelves turned by 90 deg
@@ -20,7 +20,7 @@ import numpy.typing as npt
 
 from models.arrays import FloatArray
 from models.errors import ModelError
-from models.layout import (
+from models.world.layout import (
     DOCK_GAP_M,
     START_CLEARANCE_M,
     WarehouseSpec,

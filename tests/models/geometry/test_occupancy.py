@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from models.errors import ModelError
-from models.occupancy import (
+from models.geometry.occupancy import (
     FREE,
     OCCUPIED,
     UNKNOWN,
@@ -14,7 +14,7 @@ from models.occupancy import (
     resample,
     resampled_obstacles,
 )
-from models.world import WarehouseSpec, generate_warehouse
+from models.world.warehouse import WarehouseSpec, generate_warehouse
 
 
 def _occupied_cells(grid):

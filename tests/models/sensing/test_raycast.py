@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from models.errors import ModelError
-from models.lidar import cast_reference
-from models.raycast import StaticScene, cast_batch
-from models.world import WarehouseSpec, box_segments, generate_warehouse
+from models.sensing.lidar import cast_reference
+from models.sensing.raycast import StaticScene, cast_batch
+from models.world.warehouse import WarehouseSpec, box_segments, generate_warehouse
 
 NO_CIRCLES = np.zeros((0, 3))
 NO_SEGMENTS = np.zeros((0, 4))
@@ -288,7 +288,7 @@ def test_circles_are_binned_in_every_cell_their_padded_box_touches_and_spill_out
     circles[0] = [gx0 + 3 * cell, gy0 + 2 * cell, cell]  # a box edge on grid lines
     circles[1, 0] = np.nan
     start, data, ids, spilled = scene.bin_circles(circles)
-    pad = 1e-7  # models.raycast._PAD_M
+    pad = 1e-7  # models.sensing.raycast._PAD_M
     lo = circles[:, :2] - (circles[:, 2:] + pad)
     hi = circles[:, :2] + (circles[:, 2:] + pad)
     inside = np.all((lo > [gx0, gy0]) & (hi < [gx0 + nx * cell, gy0 + ny * cell]), axis=1)
@@ -310,7 +310,7 @@ def test_circles_are_binned_in_every_cell_their_padded_box_touches_and_spill_out
 
 
 def test_the_scene_cell_follows_the_spacing_of_the_segments_within_one_to_two_metres():
-    from models.raycast import scene_cell_m
+    from models.sensing.raycast import scene_cell_m
 
     hall = box_segments(np.array([[0.0, 0.0, 30.0, 30.0]]))
     sparse = np.vstack([hall, box_segments(np.array([[10.0, 10.0, 12.0, 10.8]] * 20))])

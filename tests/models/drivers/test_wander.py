@@ -2,7 +2,7 @@ import math
 
 import numpy as np
 
-from models.wander import WanderParams, wander
+from models.drivers.wander import WanderParams, wander
 
 ANGLES = -math.pi + 2 * math.pi / 360 * np.arange(360)
 

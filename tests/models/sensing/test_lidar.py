@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from models.lidar import (
+from models.sensing.lidar import (
     ScanGeometry,
     apply_sensor_model,
     beam_directions,
@@ -13,7 +13,7 @@ from models.lidar import (
     hits_within,
     seen_beyond,
 )
-from models.world import box_segments
+from models.world.warehouse import box_segments
 
 
 def test_a_360_degree_scan_has_no_duplicated_beam():
