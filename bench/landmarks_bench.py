@@ -24,11 +24,10 @@ from scale_bench import HALLS, Hall
 
 import cosim
 from adapters.world.warehouse import spec_from_scenario
-from models.geometry.occupancy import ground_truth_grid
 from models.navigation.costmap import INSCRIBED, CostmapParams, StaticCostmap, with_obstacles
 from models.navigation.landmarks import LandmarkCache, Landmarks
 from models.navigation.planner import plan, prune_path, shortest_path_length_m
-from models.world.warehouse import generate_warehouse
+from models.world.warehouse import generate_warehouse, ground_truth_grid
 
 Result = dict[str, Any]
 RESOLUTION_M = 0.1

@@ -12,10 +12,9 @@ from typing import Any, TypeVar
 
 import numpy as np
 
-from models.geometry.occupancy import ground_truth_grid
 from models.navigation.costmap import INSCRIBED, CostmapParams, StaticCostmap, with_obstacles
 from models.navigation.planner import PlanResult, plan, prune_path, shortest_path_length_m
-from models.world.warehouse import WarehouseSpec, generate_warehouse
+from models.world.warehouse import WarehouseSpec, generate_warehouse, ground_truth_grid
 
 Result = dict[str, Any]
 T = TypeVar("T")

@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from models.fleet.kinematics import FleetState, Motion, wrap_angle
+from models.fleet.kinematics import FleetState, Motion
+from models.geometry.angles import wrap_angles
 
 
 class Mirrors:
@@ -64,6 +65,6 @@ class Mirrors:
         dx, dy = x - fleet.x[idx], y - fleet.y[idx]
         heading = fleet.yaw[idx]
         motion.v[idx] = (dx * np.cos(heading) + dy * np.sin(heading)) / dt_s
-        motion.w[idx] = wrap_angle(yaw - heading) / dt_s
-        motion.x[idx], motion.y[idx], motion.yaw[idx] = x, y, wrap_angle(yaw)
+        motion.w[idx] = wrap_angles(yaw - heading) / dt_s
+        motion.x[idx], motion.y[idx], motion.yaw[idx] = x, y, wrap_angles(yaw)
         self.fresh[idx] = False

@@ -31,7 +31,7 @@ from traci import constants as tc
 from adapters.humans.files import sumo_tool
 from cosim.core.errors import BridgeError
 from models.arrays import FloatArray
-from models.fleet.kinematics import wrap_angle
+from models.geometry.angles import wrap_angles
 
 SUMO_ERRORS: tuple[type[BaseException], ...] = (
     libsumo.TraCIException,
@@ -87,7 +87,7 @@ class Movers:
 
 def yaw_of_angle(angle_deg: FloatArray) -> FloatArray:
     """SUMO's heading (deg, clockwise from north) as yaw (rad, counter-clockwise from +x)."""
-    return wrap_angle(np.radians(90.0 - np.asarray(angle_deg)))
+    return wrap_angles(np.radians(90.0 - np.asarray(angle_deg)))
 
 
 def angle_of_yaw(yaw_rad: float) -> float:

@@ -20,6 +20,7 @@ import numpy.typing as npt
 from adapters.mocap.tracks import planar_pose
 from cosim.core.bags import BagMessage, bag_info, read_messages
 from cosim.core.errors import BagError
+from models.geometry.angles import wrap_angle
 
 SCAN_TYPES = ("sensor_msgs/msg/LaserScan",)
 ODOM_TYPES = ("nav_msgs/msg/Odometry",)
@@ -53,11 +54,11 @@ class _Track:
             return float(x), float(y), float(yaw)
         a = (t_ns - t[k - 1]) / (t[k] - t[k - 1])
         p, q = self.xyyaw[k - 1], self.xyyaw[k]
-        dyaw = math.remainder(q[2] - p[2], 2 * math.pi)
+        dyaw = wrap_angle(q[2] - p[2])
         return (
             float(p[0] + a * (q[0] - p[0])),
             float(p[1] + a * (q[1] - p[1])),
-            float(math.remainder(p[2] + a * dyaw, 2 * math.pi)),
+            float(wrap_angle(p[2] + a * dyaw)),
         )
 
 

@@ -20,8 +20,8 @@ import numpy.typing as npt
 
 from cosim.core.bags import bag_info, read_messages
 from cosim.core.errors import BagError, CosimError
+from models.geometry.angles import wrap_angles
 from models.geometry.se2 import yaw_of_quaternion
-from models.mocap.sampling import wrap_yaw
 
 POSE_TYPES = (
     "geometry_msgs/msg/PoseStamped",
@@ -230,5 +230,5 @@ def read_csv_track(path: Path) -> PoseTrack:
     t_ns = np.round(array[:, 0] * 1e9).astype(np.int64)
     if np.any(np.diff(t_ns) <= 0):
         raise TrackError(f"{path}: two rows closer than 1 ns in time; expected distinct times")
-    headings = wrap_yaw(array[:, 3])
+    headings = wrap_angles(array[:, 3])
     return PoseTrack(t_ns, array[:, 1], array[:, 2], headings, "", str(path), "csv")

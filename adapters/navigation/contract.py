@@ -27,10 +27,10 @@ from cosim.core.adapter import RunContext
 from cosim.core.registry import Registry
 from models.arrays import BoolArray, FloatArray, IntArray, UInt8Array
 from models.fleet.kinematics import DriveLimits
-from models.geometry.occupancy import OccupancyGrid, ground_truth_grid
+from models.geometry.occupancy import OccupancyGrid
 from models.navigation.costmap import StaticCostmap
 from models.navigation.traffic import MovingPoints
-from models.world.warehouse import Warehouse
+from models.world.warehouse import Warehouse, ground_truth_grid
 
 Route = tuple[FloatArray, float]
 """A path: (k, 2) waypoints in ``map`` (m), the last one the goal, and its length (m)."""

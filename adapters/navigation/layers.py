@@ -24,13 +24,12 @@ from models.geometry.occupancy import (
     OCCUPIED,
     UNKNOWN,
     OccupancyGrid,
-    ground_truth_grid,
     resample,
     resampled_obstacles,
 )
 from models.navigation.costmap import INSCRIBED, CostmapParams, StaticCostmap
 from models.navigation.lanes import TWO_WAY, aisle_lanes
-from models.world.warehouse import Warehouse
+from models.world.warehouse import Warehouse, ground_truth_grid
 
 
 class StaticLayer:

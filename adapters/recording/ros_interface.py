@@ -54,8 +54,7 @@ from cosim.core.messages import (
 from cosim.core.messages.scene import RGBA, MarkerAction
 from cosim.scenario.sections import RobotsConfig
 from models.fleet.kinematics import FleetState
-from models.geometry.occupancy import ground_truth_grid
-from models.world.warehouse import Warehouse
+from models.world.warehouse import Warehouse, ground_truth_grid
 
 MAP_RESOLUTION_M = 0.05
 """Cell size of ``/map`` (m), map_server's usual resolution."""

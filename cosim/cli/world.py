@@ -9,7 +9,7 @@ from adapters.world.warehouse import scenario_warehouse
 from cosim.core.errors import ConfigError
 from cosim.scenario.model import Scenario
 from models.errors import ModelError
-from models.geometry.occupancy import ground_truth_grid
+from models.world.warehouse import ground_truth_grid
 
 
 def world_command(

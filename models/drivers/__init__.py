@@ -1,1 +1,1 @@
-"""drivers."""
+"""Simple robot behaviours a driver runs instead of navigation: go to a goal, wander."""

@@ -13,7 +13,7 @@ import numpy as np
 import numpy.typing as npt
 
 from models.arrays import FloatArray
-from models.fleet.kinematics import wrap_angle
+from models.geometry.angles import wrap_angles
 
 
 @dataclass(frozen=True)
@@ -60,7 +60,7 @@ def go_to_goal(
     dx = goal_x - x
     dy = goal_y - y
     distance = np.hypot(dx, dy)
-    error = wrap_angle(np.arctan2(dy, dx) - yaw)
+    error = wrap_angles(np.arctan2(dy, dx) - yaw)
     arrived = distance <= gains.tolerance_m
     w = gains.k_heading * error
     v = np.minimum(max_speed_mps, gains.k_distance * distance) * np.cos(error)

@@ -1,1 +1,1 @@
-"""fleet."""
+"""The fleet's physics: differential-drive kinematics, drifting odometry, contacts."""

@@ -1,1 +1,1 @@
-"""geometry."""
+"""Planar geometry every capability shares: angles, rigid transforms, occupancy grids."""

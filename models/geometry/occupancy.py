@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numba
 import numpy as np
@@ -17,9 +17,6 @@ import numpy.typing as npt
 
 from models.arrays import FloatArray, IntArray
 from models.errors import ModelError
-
-if TYPE_CHECKING:
-    from models.world.warehouse import Warehouse
 
 FREE = 0
 """Cell value of a free cell (ROS convention)."""
@@ -179,20 +176,6 @@ def rasterize_boxes(
             # one slice assignment per box; an empty slice (degenerate or outside) is a no-op
             data[r0[i] : r1[i], c0[i] : c1[i]] = OCCUPIED
     return OccupancyGrid(resolution_m=resolution_m, origin_xy_m=(xmin, ymin), data=data)
-
-
-def ground_truth_grid(warehouse: Warehouse, resolution_m: float) -> OccupancyGrid:
-    """The ground-truth occupancy of a warehouse's walls and shelves.
-
-    Args:
-        warehouse: the generated world.
-        resolution_m: cell edge length (m/cell).
-
-    Returns:
-        A grid covering :attr:`models.world.warehouse.Warehouse.bounds` (walls included) with every
-        cell free or occupied; robots are not obstacles.
-    """
-    return rasterize_boxes(warehouse.boxes, warehouse.bounds, resolution_m)
 
 
 def resample(grid: OccupancyGrid, resolution_m: float) -> OccupancyGrid:

@@ -35,6 +35,7 @@ import numpy.typing as npt
 from scipy.stats import chi2 as chi_square
 
 from models.arrays import FloatArray
+from models.geometry.angles import wrap_angle
 from models.geometry.se2 import Pose, compose, relative
 from models.mapping.grid import LogOddsMap, MapGeometry
 from models.mapping.matcher import MatcherParams, match, scan_points
@@ -341,7 +342,7 @@ class LoopCloser:
             [
                 edge.z[0] - predicted[0],
                 edge.z[1] - predicted[1],
-                math.remainder(edge.z[2] - predicted[2], 2 * math.pi),
+                wrap_angle(edge.z[2] - predicted[2]),
             ]
         )
         total = chain + _covariance(edge)
@@ -355,7 +356,7 @@ class LoopCloser:
             [
                 edge.z[0] - predicted[0],
                 edge.z[1] - predicted[1],
-                math.remainder(edge.z[2] - predicted[2], 2 * math.pi),
+                wrap_angle(edge.z[2] - predicted[2]),
             ]
         )
         w = edge.whitening() @ innovation
@@ -424,7 +425,7 @@ class LoopCloser:
             [
                 via_first[0] - via_second[0],
                 via_first[1] - via_second[1],
-                math.remainder(via_first[2] - via_second[2], 2 * math.pi),
+                wrap_angle(via_first[2] - via_second[2]),
             ]
         )
         return float(e @ np.linalg.solve(total, e)) <= self.params.max_disagreement

@@ -23,7 +23,8 @@ from scipy.sparse import csr_matrix, diags
 from scipy.sparse.linalg import spsolve
 
 from models.arrays import FloatArray
-from models.geometry.se2 import Pose, wrap
+from models.geometry.angles import wrap_angle, wrap_angles
+from models.geometry.se2 import Pose
 
 
 class Edge(NamedTuple):
@@ -117,7 +118,7 @@ class PoseGraph:
                 step = spsolve(h + diags(lam * (diag + 1e-9)), -g)
                 q = p.copy()
                 q[1:] += step.reshape(n - 1, 3)
-                q[:, 2] = np.remainder(q[:, 2] + np.pi, 2 * np.pi) - np.pi
+                q[:, 2] = wrap_angles(q[:, 2])
                 trial = _cost(q, a, b, z, s)
                 if trial <= cost:
                     p, cost, lam = q, trial, max(lam / 10, 1e-9)
@@ -127,7 +128,7 @@ class PoseGraph:
                     break
             if lam > 1e6 or np.abs(step).max() < tolerance:
                 break
-        return [(float(x), float(y), wrap(float(t))) for x, y, t in p]
+        return [(float(x), float(y), wrap_angle(float(t))) for x, y, t in p]
 
     def _arrays(self) -> tuple[np.ndarray, np.ndarray, FloatArray, FloatArray]:
         a = np.array([e.a for e in self.edges])
@@ -149,7 +150,7 @@ def _errors(p: FloatArray, a: np.ndarray, b: np.ndarray, z: FloatArray) -> Float
     c, s = np.cos(p[a, 2]), np.sin(p[a, 2])
     ex = c * dx + s * dy - z[:, 0]
     ey = -s * dx + c * dy - z[:, 1]
-    et = np.remainder(p[b, 2] - p[a, 2] - z[:, 2] + np.pi, 2 * np.pi) - np.pi
+    et = wrap_angles(p[b, 2] - p[a, 2] - z[:, 2])
     return np.stack([ex, ey, et], axis=1)
 
 

@@ -16,6 +16,7 @@ import numpy as np
 import numpy.typing as npt
 
 from models.arrays import FloatArray
+from models.geometry.angles import wrap_angle, wrap_angles
 
 BoolArray = npt.NDArray[np.bool_]
 IntArray = npt.NDArray[np.int64]
@@ -77,7 +78,7 @@ class PoseGate:
         out_of_order = finite & has_last & (dt_s <= 0)
         with np.errstate(invalid="ignore"):  # non-finite rows are rejected above
             moved = np.hypot(new[:, 0] - last[:, 0], new[:, 1] - last[:, 1])
-            turned = np.abs((new[:, 2] - last[:, 2] + np.pi) % (2 * np.pi) - np.pi)
+            turned = np.abs(wrap_angles(new[:, 2] - last[:, 2]))
         reach = self.max_speed_mps * np.maximum(dt_s, 0.0) + self.tolerance_m
         turn = self.max_yaw_rate_radps * np.maximum(dt_s, 0.0) + self.tolerance_rad
         jump = ~finite | (has_last & ~out_of_order & ((moved > reach) | (turned > turn)))
@@ -103,7 +104,7 @@ class PoseGate:
         if dt_s <= 0:
             return "out_of_order"
         moved = math.hypot(new[0] - last[0], new[1] - last[1])
-        turned = abs((new[2] - last[2] + math.pi) % (2 * math.pi) - math.pi)
+        turned = abs(wrap_angle(new[2] - last[2]))
         if moved > self.max_speed_mps * dt_s + self.tolerance_m:
             return "jump"
         if turned > self.max_yaw_rate_radps * dt_s + self.tolerance_rad:

@@ -15,6 +15,7 @@ import numpy as np
 import numpy.typing as npt
 
 from models.arrays import FloatArray
+from models.geometry.angles import wrap_angles
 
 
 @dataclass(frozen=True)
@@ -58,19 +59,6 @@ class Measurement:
     seen: npt.NDArray[np.bool_]
 
 
-def wrap_yaw(yaw_rad: npt.ArrayLike) -> FloatArray:
-    """Headings (rad) wrapped into [-pi, pi); those already in it are returned unchanged.
-
-    ``(a + pi) % 2pi - pi`` alone rounds headings that need no wrapping (0.1 becomes
-    0.10000000000000009) and sends one a hair below -pi to +pi, because ``-tiny % 2pi``
-    rounds up to 2pi.
-    """
-    yaw = np.asarray(yaw_rad, dtype=np.float64)
-    wrapped = (yaw + np.pi) % (2 * np.pi) - np.pi
-    wrapped = np.where(wrapped >= np.pi, -np.pi, wrapped)
-    return np.where((yaw >= -np.pi) & (yaw < np.pi), yaw, wrapped)
-
-
 def measure(
     truth: FloatArray, normals: FloatArray, uniforms: FloatArray, params: MocapParams
 ) -> Measurement:
@@ -85,6 +73,6 @@ def measure(
     truth = np.asarray(truth, dtype=float).reshape(-1, 3)
     scale = np.array([params.noise_std_m, params.noise_std_m, params.noise_std_rad])
     poses = truth + np.asarray(normals, dtype=float).reshape(-1, 3) * scale
-    poses[:, 2] = wrap_yaw(poses[:, 2])
+    poses[:, 2] = wrap_angles(poses[:, 2])
     seen = np.asarray(uniforms, dtype=float).reshape(-1) >= params.dropout
     return Measurement(poses, seen)

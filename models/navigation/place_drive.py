@@ -19,7 +19,8 @@ import numba
 import numpy as np
 
 from models.arrays import FloatArray, IntArray
-from models.fleet.kinematics import DriveLimits, wrap_angle
+from models.fleet.kinematics import DriveLimits
+from models.geometry.angles import wrap_angles
 
 TURN_FIRST_RAD = 0.3
 """Heading error above which a robot turns on the spot before driving (rad)."""
@@ -97,7 +98,7 @@ def place_drive(
     """
     delta = points - poses[:, :2]
     distance = np.hypot(delta[:, 0], delta[:, 1])
-    error = wrap_angle(np.arctan2(delta[:, 1], delta[:, 0]) - poses[:, 2])
+    error = wrap_angles(np.arctan2(delta[:, 1], delta[:, 0]) - poses[:, 2])
     there = distance < THERE_M
     w = np.clip(YAW_GAIN * error, -limits.max_yaw_rate_radps, limits.max_yaw_rate_radps)
     # brake onto the point: the speed from which the robot stops on it

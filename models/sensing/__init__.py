@@ -1,1 +1,1 @@
-"""sensing."""
+"""Sensing: the planar lidar's beams and error model, and batched exact ray casting."""

@@ -20,6 +20,7 @@ import numpy.typing as npt
 
 from models.arrays import FloatArray
 from models.errors import ModelError
+from models.geometry.occupancy import OccupancyGrid, rasterize_boxes
 from models.world.layout import (
     DOCK_GAP_M,
     START_CLEARANCE_M,
@@ -332,3 +333,17 @@ __all__ = [
     "dock_rows",
     "generate_warehouse",
 ]
+
+
+def ground_truth_grid(warehouse: Warehouse, resolution_m: float) -> OccupancyGrid:
+    """The ground-truth occupancy of a warehouse's walls and shelves.
+
+    Args:
+        warehouse: the generated world.
+        resolution_m: cell edge length (m/cell).
+
+    Returns:
+        A grid covering :attr:`models.world.warehouse.Warehouse.bounds` (walls included) with every
+        cell free or occupied; robots are not obstacles.
+    """
+    return rasterize_boxes(warehouse.boxes, warehouse.bounds, resolution_m)

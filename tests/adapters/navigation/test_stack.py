@@ -285,9 +285,10 @@ def test_robots_that_map_drive_on_the_buildings_lanes_laid_into_their_wider_maps
     from adapters.navigation.layers import lanes_on
     from adapters.navigation.traffic_policies import LANE_WIDTH_M
     from adapters.world.warehouse import scenario_warehouse
-    from models.geometry.occupancy import OCCUPIED, OccupancyGrid, ground_truth_grid
+    from models.geometry.occupancy import OCCUPIED, OccupancyGrid
     from models.navigation.costmap import CostmapParams, StaticCostmap
     from models.navigation.lanes import TWO_WAY, aisle_lanes
+    from models.world.warehouse import ground_truth_grid
 
     scenario = cosim.load_scenario("warehouse-mapping", {"navigation.traffic": "lanes"})
     truth = ground_truth_grid(scenario_warehouse(scenario), 0.1)

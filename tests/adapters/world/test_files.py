@@ -16,8 +16,8 @@ from adapters.world.files import (
 )
 from cosim.core.errors import ConfigError, ExportError
 from cosim.plotting.world import world_figure
-from models.geometry.occupancy import FREE, OCCUPIED, UNKNOWN, OccupancyGrid, ground_truth_grid
-from models.world.warehouse import Warehouse, WarehouseSpec, generate_warehouse
+from models.geometry.occupancy import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from models.world.warehouse import Warehouse, WarehouseSpec, generate_warehouse, ground_truth_grid
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 

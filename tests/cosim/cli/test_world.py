@@ -11,8 +11,7 @@ from adapters.world.warehouse import scenario_warehouse
 from cosim.cli.world import world_command
 from cosim.core.errors import ConfigError, ScenarioError
 from cosim.runner.assembly import assemble
-from models.geometry.occupancy import ground_truth_grid
-from models.world.warehouse import Warehouse
+from models.world.warehouse import Warehouse, ground_truth_grid
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 

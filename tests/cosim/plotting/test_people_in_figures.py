@@ -173,7 +173,7 @@ def test_a_snapshot_shows_everyone_at_the_latest_sample_before_its_time(people_r
 def test_the_redrawn_lidar_beams_stop_at_people_as_the_run_s_lidar_did(people_run):
     from cosim.plotting.people import PeopleSamples
     from cosim.plotting.rays import LidarRays
-    from models.fleet.kinematics import wrap_angle
+    from models.geometry.angles import wrap_angles
 
     samples = PeopleSamples(people_run)
     track = people_run.track
@@ -192,7 +192,7 @@ def test_the_redrawn_lidar_beams_stop_at_people_as_the_run_s_lidar_did(people_ru
                     continue
                 bearings = np.arctan2(ends[:, 1] - origin[1], ends[:, 0] - origin[0])
                 toward = np.arctan2(y - origin[1], x - origin[0])
-                beam = int(np.argmin(np.abs(wrap_angle(bearings - toward))))
+                beam = int(np.argmin(np.abs(wrap_angles(bearings - toward))))
                 assert reach[beam] <= gap - r + 0.05  # stopped at (or before) the person
                 checked += 1
     assert checked > 0

@@ -11,8 +11,8 @@ from models.fleet.kinematics import (
     integrate,
     integrate_fleet,
     limit_commands,
-    wrap_angle,
 )
+from models.geometry.angles import wrap_angles
 
 LIMITS = DriveLimits(1.0, 0.3, 2.0, 2.0, 3.0)
 
@@ -47,7 +47,7 @@ def test_integration_matches_a_fine_numerical_solution(v, w, yaw, dt):
     xr, yr, yawr = _rk4(1.0, 2.0, yaw, v, w, dt)
     assert x1[0] == pytest.approx(xr, abs=1e-9)
     assert y1[0] == pytest.approx(yr, abs=1e-9)
-    assert wrap_angle(yaw1[0] - yawr) == pytest.approx(0.0, abs=1e-9)
+    assert wrap_angles(yaw1[0] - yawr) == pytest.approx(0.0, abs=1e-9)
 
 
 def test_a_full_circle_returns_to_the_start():
@@ -98,12 +98,6 @@ def test_the_fleet_steps_all_robots_at_once_and_stopped_robots_stay_put():
     assert (fleet.x[1], fleet.y[1]) == (5.0, 5.0)
     assert fleet.distance_m[0] == pytest.approx(4.775, abs=1e-9)
     assert fleet.distance_m[1] == 0.0
-
-
-def test_wrap_angle_maps_into_minus_pi_to_pi():
-    angles = wrap_angle(np.array([math.pi, -math.pi, 3 * math.pi, 0.1, -7.0]))
-    assert np.all(angles >= -math.pi) and np.all(angles < math.pi)
-    assert angles[3] == pytest.approx(0.1)
 
 
 def _bits(*arrays):

@@ -9,12 +9,11 @@ from models.geometry.occupancy import (
     OCCUPIED,
     UNKNOWN,
     OccupancyGrid,
-    ground_truth_grid,
     rasterize_boxes,
     resample,
     resampled_obstacles,
 )
-from models.world.warehouse import WarehouseSpec, generate_warehouse
+from models.world.warehouse import WarehouseSpec, generate_warehouse, ground_truth_grid
 
 
 def _occupied_cells(grid):

@@ -3,7 +3,7 @@ import math
 import numpy as np
 import pytest
 
-from models.mocap.sampling import MocapParams, measure, wrap_yaw
+from models.mocap.sampling import MocapParams, measure
 
 N = 20_000
 EXACT = MocapParams(noise_std_m=0.0, noise_std_rad=0.0)
@@ -73,11 +73,6 @@ def test_a_measured_yaw_is_wrapped_into_minus_pi_to_pi_as_the_same_heading(yaw):
     assert -math.pi <= wrapped < math.pi
     assert math.cos(wrapped) == pytest.approx(math.cos(yaw), abs=1e-9)
     assert math.sin(wrapped) == pytest.approx(math.sin(yaw), abs=1e-9)
-
-
-def test_wrapping_keeps_every_heading_already_in_range_bit_for_bit():
-    yaw = np.linspace(-math.pi, math.pi, 10_001)[:-1]
-    assert np.array_equal(wrap_yaw(yaw), yaw)
 
 
 def test_noise_that_carries_a_yaw_past_pi_wraps_it():

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from models.errors import ModelError
-from models.fleet.kinematics import DriveLimits, FleetState, integrate, wrap_angle
+from models.fleet.kinematics import DriveLimits, FleetState, integrate
+from models.geometry.angles import wrap_angles
 from models.navigation.dwa import DwaParams, dwa_batch
 from models.sensing.raycast import StaticScene, cast_batch
 from models.world.warehouse import WarehouseSpec, generate_warehouse
@@ -120,7 +121,9 @@ def test_a_robot_in_open_space_speeds_up_to_full_speed_towards_a_carrot_ahead():
 def test_a_robot_turns_on_the_spot_towards_a_carrot_behind():
     trace = _simulate([(0.0, 0.0, 0.0)], [(-4.0, 0.1)], NO_SEGMENTS, 4.0)
     pose = trace["pose"][:, 0]
-    bearing_error = np.abs(wrap_angle(np.arctan2(0.1 - pose[:, 1], -4.0 - pose[:, 0]) - pose[:, 2]))
+    bearing_error = np.abs(
+        wrap_angles(np.arctan2(0.1 - pose[:, 1], -4.0 - pose[:, 0]) - pose[:, 2])
+    )
     facing_away = bearing_error > math.pi / 2
     assert facing_away[0] and not facing_away[-1]
     assert np.hypot(pose[facing_away, 0], pose[facing_away, 1]).max() < 0.05

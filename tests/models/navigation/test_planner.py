@@ -6,7 +6,7 @@ import pytest
 from scipy.sparse.csgraph import dijkstra
 
 from models.errors import ModelError
-from models.geometry.occupancy import OCCUPIED, OccupancyGrid, ground_truth_grid
+from models.geometry.occupancy import OCCUPIED, OccupancyGrid
 from models.navigation.costmap import (
     INSCRIBED,
     LETHAL,
@@ -23,7 +23,7 @@ from models.navigation.planner import (
     reachable,
     shortest_path_length_m,
 )
-from models.world.warehouse import WarehouseSpec, generate_warehouse
+from models.world.warehouse import WarehouseSpec, generate_warehouse, ground_truth_grid
 from tests.models.navigation.grid_graph import planner_graph
 
 RES = 0.1
