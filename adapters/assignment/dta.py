@@ -65,7 +65,7 @@ from cosim.core.messages import (
     TaskOrder,
     TaskSet,
 )
-from cosim.core.recorder import TableSpec
+from cosim.core.table import TableSpec
 from cosim.core.timebase import period_ns, s_to_ns
 from models.assignment.problem import AssignmentProblem
 from models.fleet.kinematics import FleetState

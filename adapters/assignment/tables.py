@@ -20,7 +20,8 @@ from typing import Any
 import numpy as np
 
 from adapters.assignment.contract import ProtocolAgent
-from cosim.core.recorder import Recorder, TableSpec
+from cosim.core.recorder import Recorder
+from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S
 from models.assignment.problem import AssignmentProblem, hungarian, objective
 

@@ -20,7 +20,7 @@ import numpy as np
 
 from adapters.fleet.motion import FleetAdapter
 from cosim.core.adapter import RunContext
-from cosim.core.recorder import TableSpec
+from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S
 from models.fleet.collision import CollisionChecker, OtherKind, Proximity
 from models.fleet.kinematics import FleetState, Motion

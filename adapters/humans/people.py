@@ -53,7 +53,7 @@ from adapters.humans.settings import HumansConfig
 from adapters.humans.tables import HUMANS, HumanRecords
 from cosim.core.adapter import RunContext
 from cosim.core.kernel import Stage
-from cosim.core.recorder import TableSpec
+from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns
 from cosim.scenario.fields import model_problem
 from cosim.scenario.sections import RobotsConfig, ScenarioSection

@@ -15,7 +15,7 @@ import numpy as np
 from adapters.humans.settings import HumansConfig
 from adapters.tasks.source import TaskSourceAdapter
 from cosim.core.adapter import RunContext
-from cosim.core.recorder import TableSpec
+from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns
 from models.fleet.kinematics import FleetState
 from models.humans.encounters import HALT_MPS, Encounters
@@ -128,10 +128,9 @@ class HumanRecords:
         contacts = driving = 0
         table = run.recorder.tables.get("collisions")
         if table is not None and len(table):
-            frame = table.frame()
-            people = frame[frame["kind"].isin(PEOPLE_KINDS)]
-            contacts = len(people)
-            driving = int((people["speed_mps"].abs() >= HALT_MPS).sum())
+            people = np.isin(table.column("kind"), list(PEOPLE_KINDS))
+            contacts = int(people.sum())
+            driving = int((np.abs(table.column("speed_mps")[people]) >= HALT_MPS).sum())
         return {
             **self._task_latencies(run),
             "humans_seen": len(self.seen),

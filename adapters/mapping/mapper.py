@@ -46,7 +46,7 @@ from cosim.core.messages import (
     TFMessage,
     Transform,
 )
-from cosim.core.recorder import TableSpec
+from cosim.core.table import TableSpec
 from cosim.core.timebase import period_ns, s_to_ns
 from cosim.scenario.sections import LidarConfig
 from models.arrays import FloatArray

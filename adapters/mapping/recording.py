@@ -17,8 +17,8 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from adapters.bags.reader import BagMessage, bag_info, read_messages
 from adapters.mocap.tracks import planar_pose
-from cosim.core.bags import BagMessage, bag_info, read_messages
 from cosim.core.errors import BagError
 from models.geometry.angles import wrap_angle
 

@@ -21,7 +21,8 @@ from typing import Any
 
 import numpy as np
 
-from cosim.core.recorder import Recorder, TableSpec
+from cosim.core.recorder import Recorder
+from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S
 from models.geometry.occupancy import OccupancyGrid, rasterize_boxes
 from models.mapping.grid import LogOddsMap, MapGeometry

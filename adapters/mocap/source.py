@@ -41,8 +41,8 @@ from cosim.core.adapter import RunContext
 from cosim.core.errors import ConfigError
 from cosim.core.hosts import HostKind
 from cosim.core.kernel import Stage
-from cosim.core.recorder import TableSpec
 from cosim.core.rng import BlockDraws
+from cosim.core.table import TableSpec
 from cosim.core.timebase import ms_to_ns, period_ns, s_to_ns
 from models.fleet.kinematics import FleetState
 from models.mocap.sampling import MocapParams, measure

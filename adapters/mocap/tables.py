@@ -12,7 +12,7 @@ from collections import Counter
 from typing import Any
 
 from cosim.core.adapter import RunContext
-from cosim.core.recorder import Table, TableSpec
+from cosim.core.table import Table, TableSpec
 from cosim.core.timebase import NS_PER_S
 
 MOCAP = TableSpec(

@@ -18,7 +18,7 @@ from typing import Any, Literal
 import numpy as np
 import numpy.typing as npt
 
-from cosim.core.bags import bag_info, read_messages
+from adapters.bags.reader import bag_info, read_messages
 from cosim.core.errors import BagError, CosimError
 from models.geometry.angles import wrap_angles
 from models.geometry.se2 import yaw_of_quaternion

@@ -60,7 +60,7 @@ from cosim.core.messages import (
     Twist,
 )
 from cosim.core.messages import OccupancyGrid as GridMessage
-from cosim.core.recorder import TableSpec
+from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns, s_to_ns
 from cosim.scenario.model import Scenario
 from cosim.scenario.sections import LidarConfig, RobotsConfig

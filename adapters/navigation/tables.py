@@ -13,7 +13,8 @@ from typing import Any
 import numpy as np
 
 from adapters.navigation.recovery import STUCK_KINDS
-from cosim.core.recorder import Recorder, TableSpec
+from cosim.core.recorder import Recorder
+from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S
 
 NAVIGATION = TableSpec(

@@ -24,7 +24,7 @@ from cosim.core.errors import ConfigError
 from cosim.core.hosts import HostId, HostKind
 from cosim.core.kernel import Stage
 from cosim.core.link import AllDelivered, DeliveryStatus, Transfer
-from cosim.core.recorder import TableSpec
+from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns
 from models.fleet.kinematics import FleetState
 from models.network.fate import Fate

@@ -21,10 +21,10 @@ import threading
 import time
 
 from adapters.naming import robot_name
+from adapters.processes import die_with_parent
 from adapters.ros2dds.domain import RunDomain, claim_run_domain
 from adapters.world.warehouse import scenario_warehouse
 from cosim.core.errors import BridgeError, ConfigError
-from cosim.core.processes import die_with_parent
 from cosim.scenario.model import Scenario
 
 READY_TIMEOUT_S = 20.0

@@ -12,7 +12,7 @@ from typing import Any, ClassVar
 
 from cosim.core.adapter import RunContext
 from cosim.core.kernel import Stage
-from cosim.core.recorder import TableSpec
+from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns
 from cosim.scenario.sections import RecordConfig
 from models.fleet.kinematics import FleetState

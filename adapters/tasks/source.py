@@ -52,7 +52,7 @@ from cosim.core.messages import (
     TaskOrder,
     TaskSet,
 )
-from cosim.core.recorder import TableSpec
+from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns, s_to_ns
 from cosim.scenario.sections import RobotsConfig, WorldConfig
 from models.fleet.kinematics import FleetState

@@ -363,7 +363,7 @@ def _cmd_study(args: argparse.Namespace) -> int:
 
 
 def _cmd_bag(args: argparse.Namespace) -> int:
-    from cosim.core.bags import bag_info, format_info
+    from adapters.bags.reader import bag_info, format_info
 
     print(format_info(bag_info(args.bag)))
     return EXIT_OK

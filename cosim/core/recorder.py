@@ -1,26 +1,24 @@
-"""The recorder: taps the bus and collects tables, built as pandas DataFrames at the end.
+"""The recorder: taps the bus and collects the run's tables, events, maps and files.
 
 Rows are kept column-wise in compact buffers during the run (integers in ``array``,
-repeated strings interned as category codes) and turned into DataFrames once, so that
-recording stays cheap on the hot path. Times are recorded in integer nanoseconds and
+repeated strings interned as category codes), so that recording stays cheap on the hot
+path; the shell turns them into DataFrames once, at the end
+(:mod:`cosim.recording.dataframes`). Times are recorded in integer nanoseconds and
 exported both as exact ``*_ns`` columns and as ``*_s`` seconds columns.
 """
 
 from __future__ import annotations
 
-import math
 from array import array
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass
 from typing import Any, Protocol
 
 import numpy as np
 import numpy.typing as npt
-import pandas as pd
 
 from cosim.core.hosts import HostId
 from cosim.core.link import DeliveryStatus, Transfer
-from cosim.core.timebase import NS_PER_S
+from cosim.core.table import Interner, Table, TableSpec
 
 
 class MapArtifact(Protocol):
@@ -46,114 +44,6 @@ class MapArtifact(Protocol):
     def data(self) -> npt.NDArray[np.int8]:
         """The cells."""
         ...
-
-
-@dataclass(frozen=True)
-class TableSpec:
-    """A table a run writes (``tables/NAME.parquet``), with what each column means.
-
-    Every table is declared once, with its columns' meanings, so that the documentation's
-    table reference is generated from the code that writes the tables. Units are in the
-    column names (``t_s``, ``x_m``, ``yaw_rad``, ``bytes``); positions are in ``map``.
-
-    Attributes:
-        name: the table's name.
-        doc: one line: what a row is.
-        columns: column -> its meaning, in output order.
-        categorical: columns of repeated strings (written as ``category``).
-        volatile: wall-clock columns: the only values that are not a function of the
-            scenario and seed (comparisons of runs leave them out).
-    """
-
-    name: str
-    doc: str
-    columns: Mapping[str, str]
-    categorical: tuple[str, ...] = ()
-    volatile: tuple[str, ...] = ()
-
-
-class _Interner:
-    """Maps repeated strings to small integer codes."""
-
-    def __init__(self) -> None:
-        self.codes: dict[str, int] = {}
-        self.values: list[str] = []
-
-    def code(self, value: str) -> int:
-        code = self.codes.get(value)
-        if code is None:
-            code = len(self.values)
-            self.codes[value] = code
-            self.values.append(value)
-        return code
-
-    def codes_of(self, values: Sequence[str]) -> npt.NDArray[np.int32]:
-        """The codes of ``values``, new values coded in order of first appearance.
-
-        A ``str`` subclass (a ``StrEnum`` member) is coded as its plain string value.
-        """
-        for value in dict.fromkeys(values):  # the distinct values, in order
-            self.code(str(value))
-        return np.fromiter(map(self.codes.__getitem__, values), np.int32, len(values))
-
-    def categorical(self, codes: npt.NDArray[np.int32]) -> pd.Categorical[str]:
-        return pd.Categorical.from_codes(codes, categories=pd.Index(self.values))
-
-
-class Table:
-    """A table filled row by row or in column batches, rows kept in append order.
-
-    Args:
-        columns: column names in output order.
-        categorical: columns holding repeated strings (exported as ``category``).
-    """
-
-    def __init__(self, columns: Sequence[str], categorical: Iterable[str] = ()) -> None:
-        if not columns:
-            raise ValueError("a table needs at least one column")
-        self.columns = list(columns)
-        self._categorical = set(categorical)
-        self._rows: dict[str, list[Any]] = {name: [] for name in self.columns}
-        self._chunks: list[dict[str, npt.NDArray[Any]]] = []
-        self._length = 0
-
-    def append(self, **row: Any) -> None:
-        """Add one row; every column must be given."""
-        rows = self._rows
-        for name in self.columns:
-            rows[name].append(row[name])
-        self._length += 1
-
-    def extend(self, **columns: Any) -> None:
-        """Add rows from equal-length arrays; scalars are repeated to that length."""
-        self._flush_rows()
-        arrays = {name: np.asarray(columns[name]) for name in self.columns}
-        length = max((a.shape[0] for a in arrays.values() if a.ndim), default=1)
-        for name, values in arrays.items():
-            if values.ndim == 0:
-                arrays[name] = np.full(length, values.item())
-            elif values.shape[0] != length:
-                raise ValueError(f"column {name!r} has {values.shape[0]} rows, expected {length}")
-        self._chunks.append(arrays)
-        self._length += length
-
-    def _flush_rows(self) -> None:
-        if self._rows[self.columns[0]]:
-            self._chunks.append({name: np.asarray(v) for name, v in self._rows.items()})
-            self._rows = {name: [] for name in self.columns}
-
-    def __len__(self) -> int:
-        return self._length
-
-    def frame(self) -> pd.DataFrame:
-        """Return the rows as a DataFrame."""
-        self._flush_rows()
-        columns: dict[str, Any] = {}
-        for name in self.columns:
-            chunks = [chunk[name] for chunk in self._chunks]
-            values: Any = np.concatenate(chunks) if chunks else np.array([], dtype=float)
-            columns[name] = pd.Categorical(values) if name in self._categorical else values
-        return pd.DataFrame(columns, columns=self.columns)
 
 
 MESSAGES = TableSpec(
@@ -204,9 +94,9 @@ class Recorder:
 
     def __init__(self, *, record_messages: bool = True) -> None:
         self.record_messages = record_messages
-        self._hosts = _Interner()
-        self._topics = _Interner()
-        self._statuses = _Interner()
+        self.hosts = Interner()
+        self.topics = Interner()
+        self.statuses = Interner()
         # the rows not packed yet, by column
         self._t_sent = array("q")
         self._t_recv = array("q")
@@ -216,7 +106,7 @@ class Recorder:
         self._bytes = array("q")
         self._status: list[str] = []
         self._chunks: list[dict[str, npt.NDArray[Any]]] = []
-        self._events = Table(("t_ns", "source", "kind", "detail"))
+        self.events = Table(("t_ns", "source", "kind", "detail"))
         self.tables: dict[str, Table] = {}
         self.specs: dict[str, TableSpec] = {}
         self.volatile: dict[str, tuple[str, ...]] = {}
@@ -330,7 +220,7 @@ class Recorder:
         """
         while len(self._src) >= (1 if rest else _FLUSH_ROWS):
             take = min(len(self._src), _FLUSH_ROWS)
-            hosts, topics, statuses = self._hosts, self._topics, self._statuses
+            hosts, topics, statuses = self.hosts, self.topics, self.statuses
             self._chunks.append(
                 {
                     "t_sent": np.array(self._t_sent[:take], dtype=np.int64),
@@ -356,7 +246,7 @@ class Recorder:
     # -- events and adapter tables ---------------------------------------------------
     def event(self, t_ns: int, source: str, kind: str, detail: str = "") -> None:
         """Record a discrete event (``source`` is the component, ``kind`` a short verb)."""
-        self._events.append(t_ns=t_ns, source=source, kind=kind, detail=detail)
+        self.events.append(t_ns=t_ns, source=source, kind=kind, detail=detail)
 
     def table(
         self,
@@ -405,54 +295,22 @@ class Recorder:
         self.files[relative] = data
 
     # -- export ----------------------------------------------------------------------
-    def messages_frame(self) -> pd.DataFrame:
-        """The messages table: one row per message and destination host."""
+    def message_columns(self) -> dict[str, npt.NDArray[Any]]:
+        """The messages table's raw columns, one row per message and destination host.
+
+        ``t_sent`` and ``t_recv`` (ns; -1 when not delivered), ``bytes``, and the codes
+        of ``src`` and ``dst`` (in :attr:`hosts`), ``topic`` (in :attr:`topics`) and
+        ``status`` (in :attr:`statuses`).
+        """
         self._flush(rest=True)
-
-        def column(name: str, dtype: type) -> npt.NDArray[Any]:
+        empty = {"t_sent": np.int64, "t_recv": np.int64, "bytes": np.int64}
+        columns: dict[str, npt.NDArray[Any]] = {}
+        for name in ("t_sent", "t_recv", "src", "dst", "topic", "bytes", "status"):
             parts = [chunk[name] for chunk in self._chunks]
-            return np.concatenate(parts) if parts else np.zeros(0, dtype=dtype)
-
-        t_sent = column("t_sent", np.int64)
-        t_recv = column("t_recv", np.int64)
-        received = t_recv >= 0
-        t_recv_s = np.where(received, t_recv / NS_PER_S, math.nan)
-        return pd.DataFrame(
-            {
-                "t_sent_s": t_sent / NS_PER_S,
-                "t_recv_s": t_recv_s,
-                "src_host": self._hosts.categorical(column("src", np.int32)),
-                "dst_host": self._hosts.categorical(column("dst", np.int32)),
-                "topic": self._topics.categorical(column("topic", np.int32)),
-                "bytes": column("bytes", np.int64),
-                "status": self._statuses.categorical(column("status", np.int32)),
-                "t_sent_ns": t_sent,
-                "t_recv_ns": pd.arrays.IntegerArray(np.where(received, t_recv, 0), ~received),
-            },
-            columns=list(MESSAGE_COLUMNS),
-        )
-
-    def events_frame(self) -> pd.DataFrame:
-        """The events table (t_s, source, kind, detail, t_ns)."""
-        frame = self._events.frame()
-        t_ns = frame["t_ns"].to_numpy(dtype=np.int64)
-        frame = frame.assign(t_s=t_ns / NS_PER_S, t_ns=t_ns)
-        for column in ("source", "kind"):
-            frame[column] = frame[column].astype("category")
-        frame["detail"] = frame["detail"].astype(str)
-        return frame[list(EVENT_COLUMNS)]
-
-    def frames(self) -> dict[str, pd.DataFrame]:
-        """Every table as a DataFrame, keyed by table name."""
-        frames = {"messages": self.messages_frame(), "events": self.events_frame()}
-        for name, table in self.tables.items():
-            frames[name] = table.frame()
-        return frames
-
-
-def ns_column(values: npt.ArrayLike) -> npt.NDArray[np.float64]:
-    """Convert an array of integer nanoseconds to float seconds."""
-    return np.asarray(values, dtype=np.int64) / NS_PER_S
+            columns[name] = (
+                np.concatenate(parts) if parts else np.zeros(0, dtype=empty.get(name, np.int32))
+            )
+        return columns
 
 
 def merge_counts(into: dict[str, Any], extra: Mapping[str, Any]) -> None:

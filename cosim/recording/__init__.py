@@ -6,6 +6,6 @@
 - ``bag``: the rosbag2 writer sink; ``foxglove``: the Foxglove WebSocket sink;
 - ``setup``: what a run records, set up and closed around the kernel.
 
-Reading bags (ours, rosbag2's, a bare ``.mcap``) is :mod:`cosim.core.bags`: adapters
+Reading bags (ours, rosbag2's, a bare ``.mcap``) is :mod:`adapters.bags.reader`: adapters
 replaying recordings rely on it too.
 """

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from cosim.core.recorder import EVENTS, MESSAGES, TableSpec
+from cosim.core.recorder import EVENTS, MESSAGES
 from cosim.core.registry import AdapterRegistry
+from cosim.core.table import TableSpec
 from cosim.runner.execute import REALTIME
 
 

@@ -17,9 +17,11 @@ import pandas as pd
 from cosim.core.adapter import AdapterType
 from cosim.core.errors import BridgeError, CosimError, RegistryError
 from cosim.core.kernel import Lateness
-from cosim.core.recorder import MapArtifact, Recorder, TableSpec, merge_counts
+from cosim.core.recorder import MapArtifact, Recorder, merge_counts
 from cosim.core.registry import AdapterRegistry
+from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S, s_to_ns
+from cosim.recording.dataframes import run_frames
 from cosim.recording.foxglove import LiveOptions
 from cosim.recording.setup import RecordingPlan, RecordingSession
 from cosim.recording.unity import UnityOptions
@@ -300,7 +302,7 @@ def _run_assembled(
     return RunResult(
         scenario,
         summary,
-        run.recorder.frames(),
+        run_frames(run.recorder),
         volatile=run.recorder.volatile,
         maps=dict(run.recorder.maps),
         files=dict(run.recorder.files),

@@ -21,7 +21,7 @@ import time
 from collections.abc import Iterator
 from types import FrameType
 
-from cosim.core.processes import die_with_parent
+from adapters.processes import die_with_parent
 
 STUDY_PID_VARIABLE = "COSIM_STUDY_PID"
 """Environment variable naming the study process, for its fork server."""

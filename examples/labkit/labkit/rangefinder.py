@@ -23,7 +23,7 @@ from cosim.core.bus import TopicQos
 from cosim.core.hosts import HostId
 from cosim.core.kernel import Stage
 from cosim.core.messages import Message
-from cosim.core.recorder import TableSpec
+from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns
 from cosim.scenario.fields import param
 from models.fleet.kinematics import FleetState
@@ -150,8 +150,8 @@ class RangeFinderAdapter:
 
     def finish(self, run: RunContext) -> Mapping[str, Any]:
         """How many readings, and the closest thing any robot saw ahead (m)."""
-        frame = self.table.frame()
-        closest = float(frame["range_m"].min()) if len(frame) else math.inf
+        ranges = self.table.column("range_m")
+        closest = float(ranges.min()) if len(ranges) else math.inf
         return {
             "rangefinder_readings": self.readings * len(self.fleet),
             "rangefinder_closest_m": round(closest, 4) if math.isfinite(closest) else None,

@@ -9,6 +9,7 @@ import cosim
 from adapters.mocap.intake import PoseIntake
 from adapters.mocap.tracks import read_pose_track
 from cosim.core.errors import BagError, ConfigError
+from cosim.recording.dataframes import table_frame
 from cosim.runner.assembly import assemble
 from cosim.runner.execute import execute
 from tests.conftest import SHARED_DATA
@@ -94,7 +95,7 @@ def test_a_pose_further_than_the_robot_can_drive_is_rejected_and_recorded():
     assert not intake.submit(0, 1_000_000, 1.0, 1.0, 0.0, mirror=False, now_ns=0)  # same stamp
     assert not intake.submit(0, 21_000_000, float("nan"), 1.0, 0.0, mirror=False, now_ns=0)
     assert intake.submit(0, 21_000_000, 1.01, 1.0, 0.0, mirror=False, now_ns=0)
-    rows = intake.records.table.frame()
+    rows = table_frame(intake.records.table)
     assert list(rows.event) == ["jump", "out_of_order", "invalid"]
     assert rows.detail.iloc[0] == "2.000 m in 0.010 s"
 

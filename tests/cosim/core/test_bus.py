@@ -11,6 +11,7 @@ from cosim.core.link import AllDelivered, DeliveryStatus, Transfer
 from cosim.core.messages import Message, Twist
 from cosim.core.recorder import Recorder
 from cosim.core.timebase import period_ns
+from cosim.recording.dataframes import messages_frame
 
 A, B, C = HostId("a"), HostId("b"), HostId("c")
 
@@ -101,7 +102,7 @@ def test_the_recorder_sees_every_delivery_and_drop_with_exact_times():
     bus.subscribe("/t", C, lambda m, e: None)
     kernel.at(1_000_000, lambda: bus.publish("/t", Twist(0.0, 0.0), A))
     kernel.run(10_000_000)
-    frame = recorder.messages_frame().sort_values("dst_host").reset_index(drop=True)
+    frame = messages_frame(recorder).sort_values("dst_host").reset_index(drop=True)
     assert list(frame["dst_host"]) == ["a", "b", "c"]
     assert list(frame["status"]) == ["delivered", "delivered", "lost"]
     assert list(frame["t_sent_ns"]) == [1_000_000] * 3
@@ -118,7 +119,7 @@ def test_a_message_without_subscribers_goes_nowhere():
     recorder = Recorder()
     bus = Bus(kernel, tap=recorder)
     bus.publish("/nobody", Twist(0.0, 0.0), A)
-    assert len(recorder.messages_frame()) == 0
+    assert len(messages_frame(recorder)) == 0
     assert bus.published == 1
 
 
@@ -133,13 +134,13 @@ def test_a_monitor_sees_every_publication_without_subscribing_or_adding_a_row():
     )
     kernel.run(300_000_000)
     assert seen == [("/cmd", A, k * 100_000_000) for k in range(3)]
-    assert len(recorder.messages_frame()) == 0  # nobody subscribed: nothing crossed the bus
+    assert len(messages_frame(recorder)) == 0  # nobody subscribed: nothing crossed the bus
     got: list[tuple[int, Message, Envelope]] = []
     bus.subscribe("/cmd", B, _collect(got, kernel))
     kernel.run(400_000_000)
     assert len(seen) == 4
     assert [t for t, _, _ in got] == [305_000_000]  # the subscriber's copy crossed the link
-    assert len(recorder.messages_frame()) == 1
+    assert len(messages_frame(recorder)) == 1
 
 
 def test_a_topic_advertised_with_two_types_is_refused():
@@ -224,7 +225,7 @@ def test_the_recorder_codes_hosts_topics_and_statuses_as_plain_strings_in_order_
     ]
     for src, dst, topic, status, t_recv in rows:
         recorder.on_transfer(1, t_recv, src, dst, topic, 10, status)
-    frame = recorder.messages_frame()
+    frame = messages_frame(recorder)
     assert list(frame["src_host"]) == ["b", "a", "b"]
     assert list(frame["dst_host"]) == ["a", "c", "b"]
     assert list(frame["topic"]) == ["/y", "/x", "/y"]
@@ -260,7 +261,7 @@ def _traffic(batched: bool) -> tuple[list[tuple[int, str, str, Envelope]], list[
 
     kernel.at(5_000, send)
     kernel.run(10_000)
-    return got, seen, recorder.messages_frame()
+    return got, seen, messages_frame(recorder)
 
 
 def test_publishing_many_at_once_is_publishing_each_in_turn():
@@ -331,7 +332,7 @@ def test_a_transmission_recorded_at_once_gives_the_rows_codes_and_counts_of_each
     """
     monkeypatch.setattr("cosim.core.recorder._FLUSH_ROWS", 2)
     batched, one_by_one = _recorded(batched=True), _recorded(batched=False)
-    frame, expected = batched.messages_frame(), one_by_one.messages_frame()
+    frame, expected = messages_frame(batched), messages_frame(one_by_one)
     pd.testing.assert_frame_equal(frame, expected)
     hosts = list(frame["src_host"].cat.categories)
     assert hosts == list(expected["src_host"].cat.categories) == ["a", "z", "b", "c", "d", "h", "g"]
@@ -379,7 +380,7 @@ def test_a_link_delivering_every_copy_at_once_delivers_and_records_as_copy_by_co
     got, recorder = _broadcasts(all_at_once=True)
     want_got, want = _broadcasts(all_at_once=False)
     assert got == want_got and len(got) == 18  # 3 broadcasts: 4 remote, 1 local; 3 replies
-    pd.testing.assert_frame_equal(recorder.messages_frame(), want.messages_frame())
+    pd.testing.assert_frame_equal(messages_frame(recorder), messages_frame(want))
     assert recorder.counts == want.counts and recorder.counts["delivered"] == 18
     assert (recorder.network_messages, recorder.network_bytes) == (
         want.network_messages,
@@ -402,8 +403,8 @@ def test_a_transmission_delivered_at_once_is_recorded_as_its_transfers(monkeypat
         b.on_transmission(
             k, src, topic, 10 + k, [Transfer(d, DeliveryStatus.DELIVERED, t_recv) for d in dsts]
         )
-    pd.testing.assert_frame_equal(a.messages_frame(), b.messages_frame())
-    assert a.counts == b.counts and len(a.messages_frame()) == 6
+    pd.testing.assert_frame_equal(messages_frame(a), messages_frame(b))
+    assert a.counts == b.counts and len(messages_frame(a)) == 6
     assert (
         (a.network_messages, a.network_bytes)
         == (b.network_messages, b.network_bytes)

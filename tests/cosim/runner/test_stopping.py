@@ -10,8 +10,8 @@ import pandas as pd
 import pytest
 
 import cosim
+from adapters.bags.reader import bag_info
 from cosim.core.adapter import RunContext
-from cosim.core.bags import bag_info
 from cosim.runner.stopping import RunStopped, StopRequest, stop_on_signals
 
 STOP_AT_NS = 2_000_000_000

@@ -8,7 +8,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from cosim.core.bags import bag_info, format_info, read_messages
+from adapters.bags.reader import bag_info, format_info, read_messages
 from cosim.core.errors import BagError
 from tests.bags import mcap_file
 from tests.conftest import SHARED_DATA
