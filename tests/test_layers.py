@@ -53,9 +53,7 @@ def test_models_never_import_simpy_cosim_or_adapters(path):
 def test_the_core_rests_on_the_standard_library_simpy_and_numpy_alone(path):
     allowed = set(sys.stdlib_module_names) | {"simpy", "numpy"}
     bad = {
-        m
-        for m in _imports(path)
-        if not _within(m, "cosim.core") and m.split(".")[0] not in allowed
+        m for m in _imports(path) if not _within(m, "cosim.core") and m.split(".")[0] not in allowed
     }
     assert not bad, f"{path} imports {bad}"
 

@@ -28,7 +28,7 @@ from typing import Any, ClassVar, Protocol
 
 from cosim.core.adapter import RunContext
 from cosim.core.messages import Message, TaskInfo
-from cosim.core.registry import Registry
+from cosim.core.registry import Group, Registry
 from models.assignment.problem import AssignmentProblem
 
 
@@ -206,6 +206,17 @@ class ProtocolInUse:
     protocol: AssignmentProtocolType
 
 
+PROTOCOLS = Group(
+    "cosim.protocols",
+    "assignment protocol",
+    "assignment protocols",
+    "`adapters.assignment.contract` (`AssignmentProtocolType`, `ProtocolAgent`)",
+    "`assignment.protocol`",
+    check=protocol_contract,
+)
+"""Task assignment protocols (``assignment.protocol``)."""
+
+
 def protocol_registry() -> Registry[type[AssignmentProtocolType]]:
     """The assignment protocols installed packages register (``cosim.protocols``)."""
-    return Registry.installed("protocol", protocol_contract)
+    return PROTOCOLS.installed()

@@ -44,7 +44,7 @@ from adapters.assignment.topics import (
     reply_topic,
 )
 from adapters.naming import topic
-from adapters.network.link import NetworkView
+from adapters.network.contract import NetworkView
 from adapters.tasks.settings import TasksConfig
 from cosim.core.adapter import RunContext
 from cosim.core.bus import Envelope

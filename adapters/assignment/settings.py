@@ -20,7 +20,7 @@ class AssignmentConfig:
         "a registered assignment protocol: 'distributed_simplex' (Buerger et al. 2012, as in "
         "ChoiRbot), 'hungarian' (centralized on the base station), 'greedy' (nearest free "
         "task) or 'cbba' (consensus-based auction, Choi et al. 2009)",
-        registry="protocol",
+        registry="cosim.protocols",
     )
     period_ms: float = param(100.0, "protocol round period (ms)", gt=0)
     round_phase: Literal["independent", "aligned"] = param(

@@ -18,7 +18,7 @@ import numpy as np
 import numpy.typing as npt
 
 from adapters.bags.reader import BagMessage, bag_info, read_messages
-from adapters.mocap.tracks import planar_pose
+from adapters.bags.tracks import planar_pose
 from cosim.core.errors import BagError
 from models.geometry.angles import wrap_angle
 

@@ -26,11 +26,13 @@ from types import TracebackType
 from typing import IO, Any
 
 from adapters.mocap import feed_worker
-from adapters.mocap.settings import SYSTEMS
 from cosim.core.errors import BridgeError
 from models.geometry.se2 import yaw_of_quaternion
 
 __all__ = ["SYSTEMS", "MotionCaptureFeed", "mock_bodies", "quaternion_yaw"]
+
+SYSTEMS = ("vicon", "optitrack", "qualisys", "vrpn", "mock")
+"""Backends the motioncapture 1.1 wheel supports (others: "Unknown motion capture type!")."""
 
 BUFFER = 4096
 """Poses kept between two drains; older ones are dropped and counted."""

@@ -13,21 +13,18 @@ from __future__ import annotations
 import string
 from collections.abc import Iterator
 from dataclasses import dataclass
-from typing import ClassVar, Literal
+from typing import Any, ClassVar
 
 from adapters.ros2dds.naming import dds_topic
+from cosim.core.registry import group_named
+from cosim.scenario.choices import choice_problems
 from cosim.scenario.fields import Problem, param
 
-MocapSource = Literal["none", "simulated", "bag", "motioncapture", "ros2", "unity"]
+NO_SOURCE = "none"
+"""``mocap.source`` of a run without motion capture (robots localize by odometry)."""
 
-EXTERNAL_SOURCES = ("bag", "motioncapture", "ros2", "unity")
-"""Sources whose poses come from outside the simulation: they move the robots they track."""
-
-LIVE_SOURCES = ("motioncapture", "ros2", "unity")
-"""External sources that send poses while the run goes (on the wall clock)."""
-
-SYSTEMS = ("vicon", "optitrack", "qualisys", "vrpn", "mock")
-"""Backends the motioncapture 1.1 wheel supports (others: "Unknown motion capture type!")."""
+SOURCES = "cosim.mocap_sources"
+"""The registry of pose sources (:mod:`adapters.mocap.contract`)."""
 
 PATTERN_TOKENS = ("robot",)
 """The ``{token}`` names ``topic_pattern`` may hold."""
@@ -40,13 +37,15 @@ class MocapConfig:
     ORDER: ClassVar[int] = 100
     """Where the section comes in a resolved scenario and in the adapters' order."""
 
-    source: MocapSource = param(
-        "none",
-        "where the poses come from: none (robots localize by odometry), simulated (from "
-        "ground truth with rate, latency, noise, dropouts), bag (a recorded ROS 2 bag or a "
-        "CSV replayed), motioncapture (live, through the motioncapture library), ros2 "
-        "(live PoseStamped topics over DDS), or unity (live PoseStamped topics a Unity scene "
-        "publishes to `cosim run --unity`)",
+    source: str = param(
+        NO_SOURCE,
+        "where the poses come from: none (robots localize by odometry), or a registered "
+        "source: simulated (from ground truth with rate, latency, noise, dropouts), bag (a "
+        "recorded ROS 2 bag or a CSV replayed), motioncapture (live, through the "
+        "motioncapture library), ros2 (live PoseStamped topics over DDS), unity (live "
+        "PoseStamped topics a Unity scene publishes to `cosim run --unity`)",
+        registry=SOURCES,
+        off=NO_SOURCE,
     )
     robots: tuple[str, ...] = param(
         (), "simulated: the robots tracked (empty: all); other sources: see bodies"
@@ -98,42 +97,12 @@ class MocapConfig:
     )
 
     def problems(self) -> Iterator[Problem]:
-        """Files, bodies and patterns that a source needs."""
-        if self.source == "bag" and not self.file:
-            yield Problem("file", self.file, "a bag or CSV file for source = 'bag'")
-        if self.source != "bag" and self.file:
-            yield Problem("file", self.file, "no file unless source = 'bag'")
-        if self.source == "bag" and len(self.bodies) > 1 and self.file.endswith(".csv"):
-            yield Problem("bodies", [list(b) for b in self.bodies], "one body for a CSV file")
-        if self.robots and self.source != "simulated":
-            yield Problem("robots", list(self.robots), "no robots unless source = 'simulated'")
-        if self.bodies and self.source not in EXTERNAL_SOURCES:
-            yield Problem(
-                "bodies",
-                [list(b) for b in self.bodies],
-                "no bodies unless source is 'bag', 'motioncapture', 'ros2' or 'unity'",
-            )
+        """Patterns and bodies; what the chosen source cannot run with; keys it leaves unused."""
         tracked = [robot for robot, _ in self.bodies]
         if len(set(tracked)) != len(tracked):
             yield Problem("bodies", [list(b) for b in self.bodies], "each robot tracked once")
         yield from self._pattern_problems()
-        by_topic = self.source in ("ros2", "unity")
-        if by_topic and "{robot}" not in self.topic_pattern and not self.bodies:
-            yield Problem("topic_pattern", self.topic_pattern, "a pattern containing {robot}")
-        if by_topic:
-            for robot, body in self.bodies:
-                reason = _topic_problem(body)
-                if reason is not None:
-                    yield Problem(
-                        "bodies", [robot, body], f"a ROS 2 topic for {self.source} ({reason})"
-                    )
-        if self.source == "motioncapture":
-            if self.system not in SYSTEMS:
-                yield Problem("system", self.system, f"one of {', '.join(SYSTEMS)}")
-            elif self.system != "mock" and not self.hostname.strip():
-                yield Problem("hostname", self.hostname, f"the {self.system} server's address")
-            if any(c.isspace() for c in self.hostname):
-                yield Problem("hostname", self.hostname, "an address without spaces")
+        yield from choice_problems(self, "source")
 
     def _pattern_problems(self) -> Iterator[Problem]:
         """``topic_pattern``: only known tokens, and a valid topic once they are filled in."""
@@ -157,27 +126,44 @@ class MocapConfig:
                     f"only the tokens {known} (not {token})",
                 )
                 return
-        reason = _topic_problem(self.topic_pattern.replace("{robot}", "robot_1"))
+        reason = topic_problem(self.topic_pattern.replace("{robot}", "robot_1"))
         if reason is not None:
             yield Problem(
                 "topic_pattern", self.topic_pattern, f"a ROS 2 topic once filled in ({reason})"
             )
 
+    def chosen(self) -> Any:
+        """The chosen source's class (:class:`~adapters.mocap.contract.PoseSource`), or None.
+
+        Raises:
+            RegistryError: for a source that cannot be loaded (a broken plugin).
+        """
+        if self.source == NO_SOURCE:
+            return None
+        return group_named(SOURCES).installed().get(self.source)
+
     @property
     def external(self) -> bool:
         """Whether the poses come from outside the simulation (and move their robots)."""
-        return self.source in EXTERNAL_SOURCES
+        source = self.chosen()
+        return source is not None and bool(source.external)
 
     def adapters(self) -> tuple[str, ...]:
         """The adapters these settings ask for: the pose source, unless ``none``."""
-        return ("mocap",) if self.source != "none" else ()
+        return () if self.source == NO_SOURCE else ("mocap",)
 
     def needs_realtime(self) -> bool:
         """A live system sends poses on the wall clock: the run must keep pace with it."""
-        return self.source in LIVE_SOURCES
+        source = self.chosen()
+        return source is not None and bool(source.live)
+
+    def uses_dds(self) -> bool:
+        """Whether the source listens on the run's DDS domain."""
+        source = self.chosen()
+        return source is not None and bool(source.uses_dds)
 
 
-def _topic_problem(name: str) -> str | None:
+def topic_problem(name: str) -> str | None:
     """Why ``name`` is not an absolute ROS 2 topic, or None."""
     try:
         dds_topic(name)

@@ -1,13 +1,17 @@
-"""Which robots are tracked, by what: the scenario's mocap and physical sections resolved.
+"""Which robots are tracked, by what: the scenario's mocap section resolved.
 
 One place decides it for every adapter that cares (the mocap source, the physical-robot
-bridge, the robots' localization), so they cannot disagree.
+bridge, the robots' localization), so they cannot disagree. Robots posed from outside
+the simulation (a physical robot) are said so by their own section
+(:class:`~adapters.mocap.contract.ExternalPoses`).
 """
 
 from __future__ import annotations
 
+from typing import Any
+
+from adapters.mocap.contract import MOCAP_SOURCES, Tracked, external_poses
 from adapters.mocap.settings import MocapConfig
-from adapters.physical.settings import PhysicalConfig
 from cosim.core.adapter import ScenarioView
 from cosim.core.errors import ConfigError
 
@@ -21,75 +25,43 @@ def _check_names(scenario: ScenarioView, names: list[str], robots: list[str], ke
             )
 
 
-def external_bodies(scenario: ScenarioView, names: list[str]) -> list[tuple[str, str]]:
-    """(robot, body) of an external mocap source (``bag``, ``motioncapture``, ``ros2``, ``unity``).
+def source_of(scenario: ScenarioView) -> Any:
+    """The class of the scenario's pose source (a ``PoseSource``), or None for ``none``."""
+    return scenario.section(MocapConfig).chosen()
 
-    Defaults: the first robot with the bag's only pose topic; each physical robot by its
-    own name (``motioncapture``) or on ``mocap.topic_pattern`` (``ros2``, ``unity``).
+
+def tracked_bodies(scenario: ScenarioView, names: list[str]) -> Tracked:
+    """(robot, body) of every robot the scenario's mocap source tracks (none: ``[]``).
 
     Raises:
-        ConfigError: for unknown robots, or a live source that tracks nobody.
+        ConfigError: for unknown robots, or an external source that tracks nobody.
     """
     cfg = scenario.section(MocapConfig)
-    if not cfg.external:
+    source = source_of(scenario)
+    if source is None:
         return []
-    pairs = list(cfg.bodies)
-    physical = list(scenario.section(PhysicalConfig).robots)
+    pairs: Tracked = source.tracks(cfg, external_poses(scenario.sections), names)
     if not pairs:
-        if cfg.source == "bag":
-            pairs = [(names[0], "")]
-        elif not physical:
-            raise ConfigError(
-                f"{scenario.source}: [mocap] bodies = []: expected [[robot, body], ...] or "
-                f"physical.robots for source = {cfg.source!r}"
-            )
-        elif cfg.source in ("ros2", "unity"):
-            pairs = [(r, cfg.topic_pattern.replace("{robot}", r)) for r in physical]
-        else:
-            pairs = [(r, r) for r in physical]
-    _check_names(scenario, names, [robot for robot, _ in pairs], "mocap.bodies")
+        raise ConfigError(
+            f"{scenario.source}: [mocap] bodies = []: expected [[robot, body], ...] or "
+            f"physical.robots for source = {cfg.source!r}"
+        )
+    key = "mocap.bodies" if source.external else "mocap.robots"
+    _check_names(scenario, names, [robot for robot, _ in pairs], key)
     return pairs
 
 
-def physical_robots(scenario: ScenarioView, names: list[str]) -> list[str]:
-    """The physical robots, checked against the fleet and the pose they need.
-
-    Raises:
-        ConfigError: for an unknown robot, or a physical robot that would have no pose.
-    """
-    robots = list(scenario.section(PhysicalConfig).robots)
-    _check_names(scenario, names, robots, "physical.robots")
-    if scenario.section(PhysicalConfig).pose == "mocap" and robots:
-        tracked = {robot for robot, _ in external_bodies(scenario, names)}
-        live = scenario.section(MocapConfig).needs_realtime()
-        missing = [robot for robot in robots if robot not in tracked or not live]
-        if missing:
-            raise ConfigError(
-                f"{scenario.source}: [physical] robots names {missing[0]!r} with pose = "
-                f"'mocap': expected it tracked by a live mocap source (mocap.source = 'ros2' "
-                f"or 'motioncapture'), or physical.pose = 'odom'"
-            )
-    return robots
-
-
-def simulated_robots(scenario: ScenarioView, names: list[str]) -> list[str]:
-    """The robots a simulated mocap tracks (``mocap.robots``, or all).
-
-    Raises:
-        ConfigError: for a robot that is not in the fleet.
-    """
-    tracked = list(scenario.section(MocapConfig).robots) or list(names)
-    _check_names(scenario, names, tracked, "mocap.robots")
-    return tracked
-
-
 def tracked_robots(scenario: ScenarioView, names: list[str]) -> list[str]:
-    """The robots whose software localizes by measured poses on ``/<robot>/pose``."""
-    cfg = scenario.section(MocapConfig)
-    if cfg.source == "simulated":
-        tracked = simulated_robots(scenario, names)
-    else:
-        tracked = [robot for robot, _ in external_bodies(scenario, names)]
-    if scenario.section(PhysicalConfig).pose == "odom":
-        tracked += [r for r in scenario.section(PhysicalConfig).robots if r not in tracked]
+    """The robots whose software localizes by measured poses on ``/<robot>/pose``.
+
+    Those the mocap source tracks, and those posed from outside by something else (a
+    physical robot's own odometry), in fleet order.
+    """
+    tracked = [robot for robot, _ in tracked_bodies(scenario, names)]
+    tracked += [r for r, by in external_poses(scenario.sections).items() if by != "mocap"]
     return [name for name in names if name in tracked]
+
+
+def live_sources() -> list[str]:
+    """The registered sources that send poses while the run goes (for messages)."""
+    return [name for name, s in MOCAP_SOURCES.installed().load_all().items() if s.live]

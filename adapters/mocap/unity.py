@@ -1,33 +1,35 @@
-"""Poses from Unity scenes: ``mocap.source = "unity"``.
+"""``mocap.source = "unity"``: poses that Unity scenes publish.
 
 A Unity scene attached to ``cosim run --unity`` (its ROS-TCP-Connector) publishes a
 ``geometry_msgs/PoseStamped`` in ``map`` for each tracked robot, on the robot's body topic
-(``mocap.bodies``, or ``mocap.topic_pattern``, ``/{robot}/pose`` by default). Adapters do
-not see the Unity server (it lives in ``cosim.recording``): the hand-over is the run's bus.
-Here each body topic is advertised as ``/unity`` + the topic (``/unity/robot_1/pose``,
+(``mocap.bodies``, or ``mocap.topic_pattern``, ``/{robot}/pose`` by default). The source
+does not see the Unity server: the hand-over is the run's bus. Each body topic is
+advertised as ``/unity`` + the topic (``/unity/robot_1/pose``,
 :class:`~cosim.core.messages.PoseStamped`); the server finds these advertisements, lets
 scenes ``__publish`` on the topics behind the prefix, checks every sample (a CDR
 PoseStamped, in ``map``, finite) and publishes the newest one of each topic from the
 ``mocap`` host every 50 ms, stamped with the kernel time it takes it in (Unity's clock is
-not the run's). This source keeps them until the mocap adapter polls, and the pose intake
-checks them as any live pose (stale, off the map, a jump).
+not the run's). This source keeps them until it is polled, and the pose intake checks
+them as any live pose (stale, off the map, a jump).
 """
 
 from __future__ import annotations
 
-from typing import Any
+from collections.abc import Iterator, Mapping
+from typing import Any, ClassVar
 
-from adapters.mocap.live import Sample
+from adapters.mocap.contract import SourceContext, Tracked
+from adapters.mocap.live import PolledSource, Sample
+from adapters.mocap.ros2 import pattern_tracks, topic_bodies_problems
 from adapters.mocap.settings import MocapConfig
 from cosim.core.adapter import RunContext
 from cosim.core.bus import Envelope
-from cosim.core.hosts import HostId
 from cosim.core.messages import Message, PoseStamped
-from models.fleet.kinematics import FleetState
+from cosim.scenario.fields import Problem
 
 UNITY_PREFIX = "/unity"
-"""Bus topics carrying Unity's poses: this prefix and the Unity-side topic (the Unity server
-in ``cosim.recording.unity.inbound`` spells it the same)."""
+"""Bus topics carrying Unity's poses: this prefix and the Unity-side topic (the Unity
+server in ``cosim.recording.unity.inbound`` spells it the same)."""
 
 
 def unity_bus_topic(body: str) -> str:
@@ -35,25 +37,42 @@ def unity_bus_topic(body: str) -> str:
     return UNITY_PREFIX + body
 
 
-def advertise_unity_poses(run: RunContext, bodies: list[tuple[int, str]]) -> None:
-    """Advertise each tracked robot's body topic, so that the Unity server takes it."""
-    for _index, body in bodies:
-        run.bus.advertise(unity_bus_topic(body), PoseStamped)
-
-
-class UnityPoseSource:
+class UnityPoseSource(PolledSource):
     """Poses of the tracked robots, published by Unity scenes (see the module docstring)."""
 
-    def __init__(self, run: RunContext, cfg: MocapConfig, bodies: list[tuple[int, str]]) -> None:
-        self.cfg = cfg
-        self.names = list(run.service(FleetState).names)
-        self.topic = dict(bodies)
+    name: ClassVar[str] = "unity"
+    uses_dds: ClassVar[bool] = False
+    keys: ClassVar[tuple[str, ...]] = ("bodies",)
+    settings_hint: ClassVar[str] = "mocap.bodies or mocap.topic_pattern, and cosim run --unity"
+
+    @classmethod
+    def problems(cls, mocap: MocapConfig) -> Iterator[Problem]:
+        """Topics, or a pattern that makes one per robot."""
+        yield from topic_bodies_problems(mocap)
+
+    @classmethod
+    def tracks(cls, mocap: MocapConfig, outside: Mapping[str, str], names: list[str]) -> Tracked:
+        """``mocap.bodies``, or each robot posed from outside on ``mocap.topic_pattern``."""
+        return pattern_tracks(mocap, outside)
+
+    @classmethod
+    def describe(cls, mocap: MocapConfig, body: str) -> str:
+        """The topic a scene publishes on."""
+        return f"geometry_msgs/PoseStamped on {body} from Unity scenes"
+
+    def __init__(self, context: SourceContext) -> None:
+        super().__init__(context)
+        self.topic = dict(context.tracked)
         self.pending: list[Sample] = []
         self.received = 0
         self.not_in_map = 0
-        host = HostId("mocap")
-        for index, body in bodies:
-            run.bus.subscribe(unity_bus_topic(body), host, self._on_pose(index))
+        for _index, body in context.tracked:  # now, so that the Unity server finds them
+            context.run.bus.advertise(unity_bus_topic(body), PoseStamped)
+
+    def connect(self, run: RunContext) -> None:
+        """Listen on every body's bus topic on the ``mocap`` host."""
+        for index, body in self.context.tracked:
+            run.bus.subscribe(unity_bus_topic(body), self.context.host, self._on_pose(index))
 
     def _on_pose(self, index: int) -> Any:
         def on_pose(message: Message, _envelope: Envelope) -> None:
@@ -73,16 +92,9 @@ class UnityPoseSource:
         taken, self.pending = self.pending, []
         return taken
 
-    def close(self) -> None:
-        """Nothing to disconnect: the Unity server belongs to the run."""
-
-    def summary(self) -> dict[str, Any]:
+    def counts(self) -> Mapping[str, Any]:
         """Poses received from Unity (before the intake's checks)."""
         return {"mocap_unity_poses": self.received, "mocap_unity_not_in_map": self.not_in_map}
-
-    def failure(self) -> str | None:
-        """Scenes come and go (the Connector reconnects): never a failure, only silence."""
-        return None
 
     def silence(self, index: int) -> str:
         """The topic listened on, and how a scene must send it."""

@@ -24,7 +24,7 @@ from typing import Any, ClassVar, Protocol
 from adapters.navigation.fleet_traffic import FleetTraffic
 from adapters.navigation.layers import StaticLayers
 from cosim.core.adapter import RunContext
-from cosim.core.registry import Registry
+from cosim.core.registry import Group, Registry
 from models.arrays import BoolArray, FloatArray, IntArray, UInt8Array
 from models.fleet.kinematics import DriveLimits
 from models.geometry.occupancy import OccupancyGrid
@@ -119,9 +119,20 @@ def controller_contract(name: str, loaded: Any) -> str | None:
     return None
 
 
+CONTROLLERS = Group(
+    "cosim.controllers",
+    "local controller",
+    "local controllers",
+    "`adapters.navigation.contract` (`LocalController`)",
+    "`navigation.controller`",
+    check=controller_contract,
+)
+"""Local controllers (``navigation.controller``)."""
+
+
 def controller_registry() -> Registry[type[LocalController]]:
     """The local controllers installed packages register (``cosim.controllers``)."""
-    return Registry.installed("controller", controller_contract)
+    return CONTROLLERS.installed()
 
 
 # -- global planners -------------------------------------------------------------------------
@@ -211,9 +222,20 @@ def planner_contract(name: str, loaded: Any) -> str | None:
     return None
 
 
+PLANNERS = Group(
+    "cosim.planners",
+    "global planner",
+    "global planners",
+    "`adapters.navigation.contract` (`GlobalPlanner`)",
+    "`navigation.planner`",
+    check=planner_contract,
+)
+"""Global planners (``navigation.planner``)."""
+
+
 def planner_registry() -> Registry[type[GlobalPlanner]]:
     """The global planners installed packages register (``cosim.planners``)."""
-    return Registry.installed("planner", planner_contract)
+    return PLANNERS.installed()
 
 
 # -- traffic policies ------------------------------------------------------------------------
@@ -268,6 +290,17 @@ def traffic_contract(name: str, loaded: Any) -> str | None:
     return None
 
 
+TRAFFIC_POLICIES = Group(
+    "cosim.traffic",
+    "traffic policy",
+    "traffic policies",
+    "`adapters.navigation.contract` (`TrafficPolicy`)",
+    "`navigation.traffic`",
+    check=traffic_contract,
+)
+"""Traffic policies (``navigation.traffic``)."""
+
+
 def traffic_registry() -> Registry[type[TrafficPolicy]]:
     """The traffic policies installed packages register (``cosim.traffic``)."""
-    return Registry.installed("traffic", traffic_contract)
+    return TRAFFIC_POLICIES.installed()

@@ -25,10 +25,10 @@ class NavigationConfig:
     """Where the section comes in a resolved scenario and in the adapters' order."""
 
     planner: str = param(
-        "astar", "global planner on the costmap, a registered planner", registry="planner"
+        "astar", "global planner on the costmap, a registered planner", registry="cosim.planners"
     )
     controller: str = param(
-        "dwa", "local controller, a registered controller", registry="controller"
+        "dwa", "local controller, a registered controller", registry="cosim.controllers"
     )
     replan_hz: float = param(1.0, "periodic global replanning rate (Hz)", gt=0, le=50)
     control_hz: float = param(10.0, "local controller rate (Hz)", gt=0, le=100)
@@ -57,7 +57,7 @@ class NavigationConfig:
         "(the planner charges 5x for a step against one); 'pibt': the fleet manager moves "
         "every robot over a 2r + 0.14 m grid of places with those one-way aisles, one PIBT "
         "step at a time (Okumura et al. 2022), robots stalled 10 s first, then the oldest goal",
-        registry="traffic",
+        registry="cosim.traffic",
     )
     goals: tuple[tuple[float, float], ...] = param(
         (),

@@ -33,12 +33,10 @@ from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar, Literal
 
+from cosim.scenario.choices import choice_problems
 from cosim.scenario.fields import Problem, param
 
 Profile = Literal["ideal", "wifi_nominal", "wifi_degraded", "wifi_stress"]
-Topology = Literal["complete", "range", "binomial", "ring", "explicit"]
-LatencyModel = Literal["constant", "normal", "lognormal", "empirical"]
-LossModel = Literal["none", "bernoulli", "gilbert_elliott"]
 
 _LINK_DEFAULTS: dict[str, Any] = {
     "latency_model": "constant",
@@ -118,15 +116,36 @@ class NetworkConfig:
     PROFILES: ClassVar[Mapping[str, Mapping[str, Any]]] = PROFILES
 
     profile: Profile = param("ideal", "preset of the link keys; explicit keys override it")
-    topology: Topology = param("complete", "which robots can talk directly")
+    backend: str = param(
+        "links",
+        "what decides if and when a message between hosts arrives: a registered network "
+        "backend (links: every link by itself, with the keys below)",
+        registry="cosim.network_backends",
+    )
+    topology: str = param(
+        "complete",
+        "which robots can talk directly: a registered topology (complete, range, binomial, "
+        "ring, explicit)",
+        registry="cosim.topologies",
+    )
     edge_prob: float = param(0.5, "binomial topology: probability of each edge", gt=0, le=1)
     edges: tuple[tuple[str, str], ...] = param((), "explicit topology: [[a, b], ...]")
-    latency_model: LatencyModel = param("constant", "one-way latency distribution")
+    latency_model: str = param(
+        "constant",
+        "one-way latency distribution: a registered latency model (constant, normal, "
+        "lognormal, empirical)",
+        registry="cosim.latency_models",
+    )
     latency_ms: float = param(0.0, "mean one-way latency (ms)", ge=0)
     jitter_ms: float = param(0.0, "latency standard deviation (ms)", ge=0)
     latency_csv: str = param("", "empirical model: CSV of measured one-way delays (ms)", path=True)
     reorder: bool = param(False, "let a later message overtake an earlier one on a link")
-    loss_model: LossModel = param("none", "packet loss process")
+    loss_model: str = param(
+        "none",
+        "packet loss process of every directed link: a registered loss model (none, "
+        "bernoulli, gilbert_elliott)",
+        registry="cosim.loss_models",
+    )
     loss_prob: float = param(0.0, "bernoulli: loss probability per message", ge=0, le=1)
     ge_p: float = param(0.0, "gilbert_elliott: P(good -> bad) per message (netem p)", ge=0, le=1)
     ge_r: float = param(1.0, "gilbert_elliott: P(bad -> good) per message (netem r)", ge=0, le=1)
@@ -153,39 +172,6 @@ class NetworkConfig:
     partitions: tuple[PartitionConfig, ...] = param((), "scheduled outages")
 
     def problems(self) -> Iterator[Problem]:
-        """Combinations that would silently do nothing or cannot work."""
-        if self.latency_model == "constant" and self.jitter_ms > 0:
-            yield Problem(
-                "jitter_ms",
-                self.jitter_ms,
-                "0 with latency_model 'constant' (use 'normal' or 'lognormal')",
-            )
-        if self.latency_model == "lognormal" and self.latency_ms <= 0:
-            yield Problem(
-                "latency_ms", self.latency_ms, "a value > 0 with latency_model 'lognormal'"
-            )
-        if self.latency_model == "empirical" and not self.latency_csv:
-            yield Problem(
-                "latency_csv",
-                self.latency_csv,
-                "a CSV file of delays (ms) with latency_model 'empirical'",
-            )
-        if self.latency_csv and self.latency_model != "empirical":
-            yield Problem(
-                "latency_csv", self.latency_csv, "no file unless latency_model = 'empirical'"
-            )
-        if self.loss_prob > 0 and self.loss_model != "bernoulli":
-            yield Problem(
-                "loss_prob",
-                self.loss_prob,
-                f"0 with loss_model {self.loss_model!r} (loss_prob is the Bernoulli "
-                "probability; Gilbert-Elliott uses ge_p, ge_r, ge_loss_bad, ge_loss_good)",
-            )
-        if self.topology == "range" and self.range_m <= 0:
-            yield Problem("range_m", self.range_m, "a range > 0 with topology 'range'")
-        if self.topology == "explicit" and not self.edges:
-            yield Problem("edges", [], "at least one [a, b] pair with topology 'explicit'")
-        if self.edges and self.topology != "explicit":
-            yield Problem(
-                "edges", [list(e) for e in self.edges], "no edges unless topology = 'explicit'"
-            )
+        """What the chosen models cannot run with, and keys only unchosen ones read."""
+        for key in ("backend", "latency_model", "loss_model", "topology"):
+            yield from choice_problems(self, key)

@@ -33,16 +33,16 @@ from typing import Any, ClassVar
 from adapters.fleet.mirror import Mirrors
 from adapters.mocap.intake import PoseIntake
 from adapters.mocap.settings import MocapConfig
-from adapters.mocap.tracking import external_bodies, physical_robots
+from adapters.mocap.tracking import live_sources, source_of, tracked_bodies
 from adapters.naming import topic
 from adapters.physical.settings import PhysicalConfig
 from adapters.ros2dds import types as dds
 from adapters.ros2dds.participant import Publisher, Subscription
 from adapters.ros2dds.qos import QosKind
 from adapters.ros2dds.session import DdsSession, dds_session
-from cosim.core.adapter import RunContext
+from cosim.core.adapter import RunContext, ScenarioView
 from cosim.core.bus import Envelope
-from cosim.core.errors import BridgeError
+from cosim.core.errors import BridgeError, ConfigError
 from cosim.core.hosts import HostId
 from cosim.core.kernel import Stage
 from cosim.core.messages import LaserScan, Message, PoseStamped, Twist
@@ -57,6 +57,35 @@ WATCH_HZ = 4.0
 
 class SilentRobotError(BridgeError):
     """A physical robot sent no usable pose for ``physical.pose_timeout_s``."""
+
+
+def physical_robots(scenario: ScenarioView, names: list[str]) -> list[str]:
+    """The physical robots, checked against the fleet and the pose they need.
+
+    Raises:
+        ConfigError: for an unknown robot, or a physical robot that would have no pose.
+    """
+    cfg = scenario.section(PhysicalConfig)
+    robots = list(cfg.robots)
+    for robot in robots:
+        if robot not in names:
+            raise ConfigError(
+                f"{scenario.source}: [physical] robots names {robot!r}: expected one of the "
+                f"robots {', '.join(names)}"
+            )
+    if cfg.pose == "mocap" and robots:
+        tracked = {robot for robot, _ in tracked_bodies(scenario, names)}
+        source = source_of(scenario)
+        live = source is not None and source.live
+        missing = [robot for robot in robots if robot not in tracked or not live]
+        if missing:
+            sources = " or ".join(repr(name) for name in live_sources())
+            raise ConfigError(
+                f"{scenario.source}: [physical] robots names {missing[0]!r} with pose = "
+                f"'mocap': expected it tracked by a live mocap source (mocap.source = "
+                f"{sources}), or physical.pose = 'odom'"
+            )
+    return robots
 
 
 class PhysicalRobot:
@@ -173,11 +202,10 @@ class PhysicalAdapter:
         if self.cfg.pose == "odom":
             return f"nav_msgs/Odometry on /{robot.name}/odom{where} (physical.pose = 'odom')"
         mocap = self.scenario.section(MocapConfig)
-        body = dict(external_bodies(self.scenario, self.fleet_names)).get(robot.name, robot.name)
-        if mocap.source == "ros2":
-            return f"geometry_msgs/PoseStamped on {body}{where} (mocap.source = 'ros2')"
-        host = mocap.hostname or "no host"
-        return f"rigid body {body!r} of the {mocap.system} motion capture at {host!r}"
+        body = dict(tracked_bodies(self.scenario, self.fleet_names)).get(robot.name, robot.name)
+        source = source_of(self.scenario)
+        said = source.describe(mocap, body) + (where if source.uses_dds else "")
+        return f"{said} (mocap.source = {mocap.source!r})"
 
     def _on_scan(
         self, run: RunContext, robot: PhysicalRobot

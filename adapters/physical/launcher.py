@@ -7,7 +7,7 @@ so the run talks to it exactly as it would to a real robot. The processes are st
 (SIGTERM, then SIGKILL) when the run ends, however it ends.
 
 The run's domain is the scenario's ``physical.dds_domain``; with ``"auto"`` it is claimed
-here for the run (:func:`adapters.ros2dds.domain.claim_run_domain`) unless the caller
+here for the run (:func:`adapters.physical.domain.claim_run_domain`) unless the caller
 claimed it first, and the run must then be given :attr:`Standins.scenario`, which names it.
 Each stand-in is told it by ``--domain`` (and ``ROS_DOMAIN_ID`` in its environment).
 """
@@ -21,8 +21,8 @@ import threading
 import time
 
 from adapters.naming import robot_name
+from adapters.physical.domain import RunDomain, claim_run_domain
 from adapters.processes import die_with_parent
-from adapters.ros2dds.domain import RunDomain, claim_run_domain
 from adapters.world.warehouse import scenario_warehouse
 from cosim.core.errors import BridgeError, ConfigError
 from cosim.scenario.model import Scenario
@@ -53,7 +53,7 @@ def standin_command(scenario: Scenario, robot: str, seed: int) -> list[str]:
     if physical.dds_domain == "auto":
         raise ConfigError(
             f"{scenario.source}: [physical] dds_domain = 'auto': expected the run's claimed "
-            "domain (claim it with adapters.ros2dds.domain.claim_run_domain first)"
+            "domain (claim it with adapters.physical.domain.claim_run_domain first)"
         )
     command = [
         sys.executable, "-m", "cosim", "standin",

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from typing import ClassVar, Literal
 
@@ -74,3 +74,14 @@ class PhysicalConfig:
     def needs_realtime(self) -> bool:
         """A physical robot lives on the wall clock: the run must keep pace with it."""
         return bool(self.robots)
+
+    def uses_dds(self) -> bool:
+        """Physical robots talk to the run over DDS."""
+        return bool(self.robots)
+
+    def external_poses(self) -> Mapping[str, str]:
+        """Every physical robot is posed from outside: by the mocap source, or its odometry.
+
+        (See :class:`adapters.mocap.contract.ExternalPoses`.)
+        """
+        return {robot: self.pose for robot in self.robots}

@@ -17,20 +17,17 @@ stand-ins (``--domain``) and what a robot is started with (``ROS_DOMAIN_ID``).
 
 from __future__ import annotations
 
-import dataclasses
 import errno
 import fcntl
 import os
 import socket
 import tempfile
+from collections.abc import Mapping
 from pathlib import Path
 from types import TracebackType
-from typing import IO
+from typing import IO, Any, Literal, Protocol, runtime_checkable
 
-from adapters.mocap.settings import MocapConfig
-from adapters.physical.settings import PhysicalConfig
 from cosim.core.errors import BridgeError
-from cosim.scenario.model import Scenario
 
 LOCK_DIR = Path(tempfile.gettempdir()) / "cosim-dds-domains"
 """Where the per-domain lock files live (one machine's runs share it)."""
@@ -44,6 +41,23 @@ UNICAST_DISCOVERY_OFFSET = 10
 """d1: a participant's unicast discovery port is PB + DG x domain + d1 + PG x index."""
 PROBED_INDICES = 10
 """Participant indices probed: Cyclone DDS on loopback takes 0-9 (``MaxAutoParticipantIndex``)."""
+
+
+@runtime_checkable
+class DomainSettings(Protocol):
+    """Settings naming a run's DDS domain: ``physical.dds_domain`` and ``physical.interface``.
+
+    """
+
+    @property
+    def dds_domain(self) -> int | Literal["auto"]:
+        """The domain (``ROS_DOMAIN_ID``), or ``"auto"``: one chosen per run."""
+        ...
+
+    @property
+    def interface(self) -> str:
+        """The network interface or address DDS uses; empty for loopback."""
+        ...
 
 
 def discovery_ports(domain: int) -> list[int]:
@@ -149,14 +163,14 @@ def _lock(domain: int) -> IO[str] | int:
     return handle
 
 
-def claim_domain(cfg: PhysicalConfig, source: str) -> DomainClaim:
+def claim_domain(cfg: DomainSettings, source: str) -> DomainClaim:
     """Claim ``cfg.dds_domain`` (or, for ``"auto"``, a free domain) for this process's run.
 
     A domain this process holds already (the command line claimed it before starting the
     stand-ins) is returned without a new lock.
 
     Args:
-        cfg: the ``[physical]`` settings.
+        cfg: the settings naming the domain (the ``[physical]`` section).
         source: the scenario file or preset, for messages.
 
     Raises:
@@ -190,49 +204,29 @@ def claim_domain(cfg: PhysicalConfig, source: str) -> DomainClaim:
     )
 
 
-def uses_dds(scenario: Scenario) -> bool:
-    """Whether a run of ``scenario`` joins a DDS domain (physical robots, or ros2 poses)."""
-    return bool(scenario.section(PhysicalConfig).robots) or (
-        scenario.section(MocapConfig).source == "ros2"
-    )
+def uses_dds(sections: Mapping[str, Any]) -> bool:
+    """Whether a run joins a DDS domain: some section says so (``uses_dds()``).
 
-
-@dataclasses.dataclass
-class RunDomain:
-    """A run's claimed domain and the scenario that names it (``dds_domain`` resolved).
-
-    Attributes:
-        claim: the claim (release it when the run ends: :meth:`close`).
-        scenario: the scenario with ``physical.dds_domain`` set to the claimed domain, to
-            be given to the stand-ins and the run alike.
+    The physical robots' section does when it names robots, the mocap section when its
+    source listens on DDS.
     """
-
-    claim: DomainClaim
-    scenario: Scenario
-
-    def close(self) -> None:
-        """Release the domain."""
-        self.claim.release()
-
-    def __enter__(self) -> RunDomain:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
+    for section in sections.values():
+        says = getattr(section, "uses_dds", None)
+        if callable(says) and says():
+            return True
+    return False
 
 
-def claim_run_domain(scenario: Scenario) -> RunDomain | None:
-    """Claim the DDS domain of a run of ``scenario``; None for a run that uses no DDS.
-
-    The command line calls it before starting stand-ins, prints
-    ``claim.describe()`` and runs ``RunDomain.scenario``.
+def domain_settings(sections: Mapping[str, Any]) -> DomainSettings:
+    """The section holding the DDS keys (``dds_domain``, ``interface``: the physical one).
 
     Raises:
-        BridgeError: as :func:`claim_domain`.
+        BridgeError: no section holds them (no package declaring them is installed).
     """
-    if not uses_dds(scenario):
-        return None
-    cfg = scenario.section(PhysicalConfig)
-    claim = claim_domain(cfg, scenario.source)
-    resolved = dataclasses.replace(cfg, dds_domain=claim.domain)
-    return RunDomain(claim, scenario.with_section("physical", resolved))
+    for section in sections.values():
+        if isinstance(section, DomainSettings):
+            return section
+    raise BridgeError(
+        "no settings section holds dds_domain and interface; expected the [physical] section "
+        "(adapters.physical.settings) to be registered"
+    )

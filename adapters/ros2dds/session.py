@@ -2,13 +2,13 @@
 
 Shared by the physical-robot bridge and a ``ros2`` mocap source, opened on first use
 (when the run starts, so ``cosim check`` opens no socket), on the domain the run claims
-(:mod:`adapters.ros2dds.domain`: ``physical.dds_domain``, or one chosen for the run).
+(:mod:`adapters.ros2dds.domain`: ``physical.dds_domain``, or one chosen for the run, from
+the section that holds the DDS keys).
 """
 
 from __future__ import annotations
 
-from adapters.physical.settings import PhysicalConfig
-from adapters.ros2dds.domain import DomainClaim, claim_domain
+from adapters.ros2dds.domain import DomainClaim, claim_domain, domain_settings
 from adapters.ros2dds.participant import RosParticipant
 from cosim.core.adapter import RunContext
 
@@ -54,7 +54,7 @@ def dds_session(run: RunContext) -> DdsSession:
         BridgeError: the domain is held by another run, no domain is free, or DDS fails.
     """
     if not run.has_service(DdsSession):
-        cfg = run.settings(PhysicalConfig)
+        cfg = domain_settings(run.scenario.sections)
         claim = claim_domain(cfg, run.scenario.source)
         try:
             participant = RosParticipant(claim.domain, interface=cfg.interface or None)

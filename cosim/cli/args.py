@@ -54,15 +54,24 @@ def _non_negative_float(text: str) -> float:
     return value
 
 
-REGISTRY_KINDS = ("adapter", "section", "driver", "protocol", "controller", "planner", "traffic")
-
-
 def _registry_kind(text: str) -> str:
-    if text not in REGISTRY_KINDS:
-        raise argparse.ArgumentTypeError(
-            f"{text!r} is not a registry; expected one of {', '.join(REGISTRY_KINDS)}"
-        )
-    return text
+    """A registry's entry-point group from its name, its short name or its singular.
+
+    ``cosim.planners``, ``planners`` and ``planner`` all name the global planners; only
+    the installed packages' metadata is read (no contract is imported).
+    """
+    from cosim.core.registry import registry_names
+
+    names = registry_names()
+    for group in names:
+        short = group.removeprefix("cosim.")
+        singular = short[:-3] + "y" if short.endswith("ies") else short.removesuffix("s")
+        if text in (group, short, singular):
+            return group
+    shorts = [group.removeprefix("cosim.") for group in names]
+    raise argparse.ArgumentTypeError(
+        f"{text!r} is not a registry; expected one of {', '.join(shorts)}"
+    )
 
 
 def _positive_int(text: str) -> int:
@@ -441,8 +450,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     listing = commands.add_parser(
         "plugins",
-        help="list every registered adapter, section, driver, protocol, controller, planner "
-        "and traffic policy",
+        help="list every registry (adapters, sections, drivers, protocols, controllers, "
+        "planners, traffic policies, mocap sources, network models, map sharing, ...) and what "
+        "is registered in it",
         description=(
             "List what installed packages register, cosim's own built-ins beside any plugin's: "
             "each entry with the package it comes from and a one-line description. A plugin "
@@ -455,7 +465,7 @@ def build_parser() -> argparse.ArgumentParser:
         nargs="*",
         metavar="KIND",
         type=_registry_kind,
-        help="only these registries (adapter, section, driver, protocol, controller, planner, "
-        "traffic); default: all",
+        help="only these registries, by entry-point group (cosim.planners), short name "
+        "(planners) or singular (planner); default: all",
     )
     return parser

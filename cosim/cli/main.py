@@ -112,8 +112,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 
 def _run_and_report(args: argparse.Namespace, stop: StopRequest, ran: list[Path]) -> int:
+    from adapters.physical.domain import claim_run_domain
     from adapters.physical.launcher import Standins
-    from adapters.ros2dds.domain import claim_run_domain
     from cosim.cli.hostname import check_live_host
     from cosim.recording.foxglove import LiveOptions
     from cosim.recording.unity import UnityOptions
@@ -425,9 +425,10 @@ def _cmd_scenarios(_args: argparse.Namespace) -> int:
 
 
 def _cmd_plugins(args: argparse.Namespace) -> int:
-    from cosim.cli.plugins import KINDS, plugin_lines
+    from cosim.cli.plugins import plugin_lines
+    from cosim.core.registry import group_named
 
-    for line in plugin_lines(args.kinds or KINDS):
+    for line in plugin_lines([group_named(kind) for kind in args.kinds] or None):
         print(line)
     return EXIT_OK
 

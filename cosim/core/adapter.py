@@ -17,6 +17,7 @@ from cosim.core.errors import RegistryError
 from cosim.core.hosts import Host, HostId, HostKind
 from cosim.core.kernel import Kernel
 from cosim.core.recorder import Recorder
+from cosim.core.registry import Group
 from cosim.core.rng import RngStreams
 
 T = TypeVar("T")
@@ -46,6 +47,11 @@ class ScenarioView(Protocol):
 
     def section(self, kind: type[T]) -> T:
         """The scenario's section of type ``kind`` (a settings dataclass)."""
+        ...
+
+    @property
+    def sections(self) -> Mapping[str, Any]:
+        """Every section by name, for hooks a capability declares and others implement."""
         ...
 
 
@@ -171,3 +177,21 @@ class Driver:
     adapters: tuple[str, ...]
     summary: str
     needs_lidar: bool = True
+
+
+def _driver_contract(name: str, loaded: Any) -> str | None:
+    if not isinstance(loaded, Driver):
+        return f"is a {type(loaded).__name__}; expected a cosim.core.adapter.Driver"
+    return None
+
+
+DRIVERS = Group(
+    "cosim.drivers",
+    "robot driver",
+    "robot drivers",
+    "a `cosim.core.adapter.Driver` (the adapters that make up the robot software)",
+    "`robots.driver`",
+    named=False,
+    check=_driver_contract,
+)
+"""Robot drivers: the robot software a scenario runs (``robots.driver``)."""

@@ -1,8 +1,8 @@
 """The link between hosts: decides if and when a message reaches another host.
 
 The bus hands every inter-host transmission to a :class:`Link`. The ideal link delivers
-at once; the network model (``adapters.network.link``) decides with latency, loss, bandwidth,
-range and partitions.
+at once; a run's network backend (``network.backend``: the built-in ``links`` models
+latency, loss, bandwidth, range and partitions) decides otherwise.
 """
 
 from __future__ import annotations

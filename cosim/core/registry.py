@@ -6,11 +6,15 @@ implementations register exactly as a third party's do: in its ``pyproject.toml`
     [project.entry-points."cosim.protocols"]
     my_auction = "my_package.auction:MyAuction"
 
-The groups are :data:`GROUPS`: adapters, settings sections, robot drivers, assignment
-protocols, local controllers, global planners and traffic policies. A registry reads the
-names of its group from the installed packages' metadata and imports an entry only when it
-is asked for, so a broken plugin is named when, and only when, a run uses it. An unknown
-name is refused with the registered names and the nearest ones.
+Each kind of pluggable thing is a :class:`Group`, declared by the contract of the
+capability it belongs to (the assignment protocols by ``adapters.assignment.contract``,
+the local controllers by ``adapters.navigation.contract``, ...): the core knows no
+capability. The groups themselves are registered in the ``cosim.registries`` entry-point
+group, so that ``cosim plugins`` and the references find every one, a plugin package's
+new kinds included. A registry reads the names of its group from the installed packages'
+metadata and imports an entry only when it is asked for, so a broken plugin is named
+when, and only when, a run uses it. An unknown name is refused with the registered names
+and the nearest ones.
 """
 
 from __future__ import annotations
@@ -26,33 +30,89 @@ from cosim.core.errors import RegistryError
 
 T = TypeVar("T")
 
-GROUPS: dict[str, str] = {
-    "adapter": "cosim.adapters",
-    "section": "cosim.sections",
-    "driver": "cosim.drivers",
-    "protocol": "cosim.protocols",
-    "controller": "cosim.controllers",
-    "planner": "cosim.planners",
-    "traffic": "cosim.traffic",
-}
-"""Registry kind -> entry-point group."""
-
-KIND_WORDS: dict[str, str] = {
-    "adapter": "adapter",
-    "section": "settings section",
-    "driver": "robot driver",
-    "protocol": "assignment protocol",
-    "controller": "local controller",
-    "planner": "global planner",
-    "traffic": "traffic policy",
-}
-"""How messages name an entry of each kind."""
-
-NAMED = frozenset({"adapter", "protocol", "controller", "planner", "traffic"})
-"""Kinds whose entries declare their own ``name`` (it must match the entry point's)."""
+REGISTRIES = "cosim.registries"
+"""The entry-point group of the groups: every kind of pluggable thing, by name."""
 
 Check = Callable[[str, Any], str | None]
 """A contract check: (name, loaded object) -> what is wrong, or None."""
+
+
+@dataclass(frozen=True)
+class Group:
+    """One kind of pluggable thing: where its entries are registered and what they are.
+
+    Declared once, by the contract of the capability it belongs to, and registered in the
+    ``cosim.registries`` entry-point group.
+
+    Attributes:
+        entry_points: the entry-point group its entries are registered in
+            (``cosim.controllers``).
+        words: how messages name one entry (``local controller``).
+        plural: how the references name several (``local controllers``).
+        contract: where its contract is declared, for the references.
+        chosen_by: the scenario key that picks an entry, for the references.
+        named: whether every entry declares its own ``name`` (checked against the entry
+            point's).
+        check: a contract check run once on every loaded entry.
+    """
+
+    entry_points: str
+    words: str
+    plural: str
+    contract: str
+    chosen_by: str
+    named: bool = True
+    check: Check | None = None
+
+    def installed(self) -> Registry[Any]:
+        """The entries installed packages register in this group (names only, no import).
+
+        Entries of cosim itself come first, in declaration order; then other packages' by
+        package name.
+        """
+        return Registry(self, _entry_points(self.entry_points))
+
+
+def installed_groups() -> list[Group]:
+    """Every group registered in ``cosim.registries`` (cosim's first), loaded.
+
+    Raises:
+        RegistryError: for a registered group that cannot be loaded or is no :class:`Group`.
+    """
+    return [group_named(name) for name in _entry_points(REGISTRIES)]
+
+
+def registry_names() -> list[str]:
+    """The entry-point groups of every registry (``cosim.registries``), none imported."""
+    return list(_entry_points(REGISTRIES))
+
+
+@cache
+def group_named(entry_points: str) -> Group:
+    """The group whose entries are registered in ``entry_points`` (``cosim.controllers``).
+
+    Settings name the group of a key this way (``param(..., registry="cosim.controllers")``)
+    so that a settings module need not import its capability's contract.
+
+    Raises:
+        RegistryError: for a group that is not registered in ``cosim.registries``, cannot
+            be loaded, or is no :class:`Group` for that entry-point group.
+    """
+    lazy = _entry_points(REGISTRIES).get(entry_points)
+    if lazy is None:
+        raise RegistryError(
+            f"no registry {entry_points!r}" + suggest_names(entry_points, _entry_points(REGISTRIES))
+        )
+    where = f"registry {entry_points!r} ({lazy.value}, package {lazy.package})"
+    try:
+        group = lazy.load()
+    except Exception as error:  # a broken plugin must name itself
+        raise RegistryError(f"{where} cannot be loaded: {type(error).__name__}: {error}") from error
+    if not isinstance(group, Group) or group.entry_points != entry_points:
+        raise RegistryError(
+            f"{where} is {group!r}; expected a cosim.core.registry.Group of {entry_points!r}"
+        )
+    return group
 
 
 @dataclass(frozen=True)
@@ -90,7 +150,7 @@ class Plugin:
     """One registered entry, as ``cosim plugins`` lists it.
 
     Attributes:
-        kind: the registry kind (``adapter``, ``protocol``, ...).
+        group: the group it is registered in.
         name: the registered name.
         package: the distribution that registers it (``cosim`` for the built-ins).
         target: ``module:attribute`` of the entry point.
@@ -98,7 +158,7 @@ class Plugin:
         error: why it cannot be loaded, or None.
     """
 
-    kind: str
+    group: Group
     name: str
     package: str
     target: str
@@ -107,38 +167,22 @@ class Plugin:
 
 
 class Registry(Generic[T]):
-    """The entries of one kind, by registered name, imported on first use.
+    """The entries of one group, by registered name, imported on first use.
 
     Args:
-        kind: the registry kind (a key of :data:`GROUPS`).
+        group: the group (its words, its contract check).
         entries: name -> entry point (imported when asked for) or the object itself.
-        check: a contract check run once on every loaded entry.
     """
 
-    def __init__(
-        self,
-        kind: str,
-        entries: Mapping[str, Lazy | T],
-        check: Check | None = None,
-    ) -> None:
-        self.kind = kind
+    def __init__(self, group: Group, entries: Mapping[str, Lazy | T]) -> None:
+        self.group = group
         self._entries: dict[str, Lazy | T] = dict(entries)
         self._loaded: dict[str, T] = {}
-        self._check = check
-
-    @classmethod
-    def installed(cls, kind: str, check: Check | None = None) -> Registry[Any]:
-        """The entries of ``kind`` that installed packages declare (names only, no import).
-
-        Entries of cosim itself come first, in declaration order; then other packages' by
-        package name.
-        """
-        return Registry(kind, _entry_points(GROUPS[kind]), check)
 
     @property
     def words(self) -> str:
-        """How messages name an entry of this kind (``assignment protocol``)."""
-        return KIND_WORDS.get(self.kind, self.kind)
+        """How messages name an entry of this group (``assignment protocol``)."""
+        return self.group.words
 
     def names(self) -> list[str]:
         """Registered names, in registry order."""
@@ -149,7 +193,7 @@ class Registry(Generic[T]):
 
     def with_entry(self, name: str, entry: T) -> Registry[T]:
         """A copy with ``entry`` registered as ``name`` (for tests and ``cosim.run``)."""
-        copy = Registry(self.kind, {**self._entries, name: entry}, self._check)
+        copy = Registry(self.group, {**self._entries, name: entry})
         copy._loaded = {k: v for k, v in self._loaded.items() if k != name}
         return copy
 
@@ -193,10 +237,11 @@ class Registry(Generic[T]):
                 raise RegistryError(
                     f"{where} cannot be loaded: {type(error).__name__}: {error}"
                 ) from error
-        declared = getattr(loaded, "name", name) if self.kind in NAMED else name
+        declared = getattr(loaded, "name", name) if self.group.named else name
         if declared != name:
             raise RegistryError(f"{where} declares name = {declared!r}; expected {name!r}")
-        problem = self._check(name, loaded) if self._check is not None else None
+        check = self.group.check
+        problem = check(name, loaded) if check is not None else None
         if problem is not None:
             raise RegistryError(f"{where}: {problem}")
         self._loaded[name] = loaded
@@ -220,13 +265,13 @@ class Registry(Generic[T]):
                 loaded = self.get(name)
             except RegistryError as error:
                 plugins.append(
-                    Plugin(self.kind, name, self.package(name), self.target(name), "", str(error))
+                    Plugin(self.group, name, self.package(name), self.target(name), "", str(error))
                 )
                 continue
             declared = getattr(loaded, "summary", None)
             doc = declared if isinstance(declared, str) else (loaded.__doc__ or "").strip()
             summary = doc.splitlines()[0] if doc else ""
-            plugins.append(Plugin(self.kind, name, self.package(name), self.target(name), summary))
+            plugins.append(Plugin(self.group, name, self.package(name), self.target(name), summary))
         return plugins
 
 
@@ -250,19 +295,6 @@ def _entry_points(group: str) -> dict[str, Lazy]:
     return entries
 
 
-def _adapter_contract(name: str, loaded: Any) -> str | None:
-    """What an adapter type lacks: ``requires``, a constructor, ``start`` and ``finish``."""
-    if not callable(loaded):
-        return "is not a class (expected a class constructed with the run)"
-    requires = getattr(loaded, "requires", None)
-    if not isinstance(requires, tuple) or not all(isinstance(r, str) for r in requires):
-        return f"requires = {requires!r}; expected a tuple of adapter names"
-    for method in ("start", "finish"):
-        if not callable(getattr(loaded, method, None)):
-            return f"has no {method}(run) method (see cosim.core.adapter.Adapter)"
-    return None
-
-
 class AdapterRegistry(Registry[Any]):
     """Adapter types by registered name, with their requirements resolved.
 
@@ -271,12 +303,12 @@ class AdapterRegistry(Registry[Any]):
     """
 
     def __init__(self, entries: Mapping[str, Any]) -> None:
-        super().__init__("adapter", entries, _adapter_contract)
+        super().__init__(ADAPTERS, entries)
 
     @classmethod
     def from_entry_points(cls) -> AdapterRegistry:
         """Every adapter that installed packages declare in ``cosim.adapters`` (not imported)."""
-        return cls(_entry_points(GROUPS["adapter"]))
+        return cls(_entry_points(ADAPTERS.entry_points))
 
     def with_adapter(self, adapter: Any) -> AdapterRegistry:
         """A copy of this registry with ``adapter`` added under its own ``name``."""
@@ -315,3 +347,27 @@ class AdapterRegistry(Registry[Any]):
         for name in names:
             visit(name)
         return ordered
+
+
+def _adapter_contract(name: str, loaded: Any) -> str | None:
+    """What an adapter type lacks: ``requires``, a constructor, ``start`` and ``finish``."""
+    if not callable(loaded):
+        return "is not a class (expected a class constructed with the run)"
+    requires = getattr(loaded, "requires", None)
+    if not isinstance(requires, tuple) or not all(isinstance(r, str) for r in requires):
+        return f"requires = {requires!r}; expected a tuple of adapter names"
+    for method in ("start", "finish"):
+        if not callable(getattr(loaded, method, None)):
+            return f"has no {method}(run) method (see cosim.core.adapter.Adapter)"
+    return None
+
+
+ADAPTERS = Group(
+    "cosim.adapters",
+    "adapter",
+    "adapters",
+    "`cosim.core.adapter` (`Adapter`, `AdapterType`, `RunContext`)",
+    "`[scenario] adapters`, and what a scenario's settings ask for",
+    check=_adapter_contract,
+)
+"""Adapters: what gives a model time, a rate and a place on the bus."""

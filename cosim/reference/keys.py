@@ -6,7 +6,7 @@ import dataclasses
 import inspect
 from typing import Any, get_args, get_type_hints
 
-from cosim.core.registry import KIND_WORDS, Registry
+from cosim.core.registry import group_named
 from cosim.scenario.fields import Bounds, describe, implicit_bounds
 from cosim.scenario.loader import toml_value
 from cosim.scenario.model import section_classes, section_registry
@@ -39,10 +39,13 @@ def _cell(text: str) -> str:
 
 
 def _expected(key: str, field: dataclasses.Field[Any], hint: Any) -> str:
-    kind = field.metadata.get("registry")
-    if kind is not None:
-        names = Registry.installed(kind).names()
-        return f"a registered {KIND_WORDS[kind]}: {', '.join(f'`{n}`' for n in names)}"
+    group_name = field.metadata.get("registry")
+    if group_name is not None:
+        group = group_named(group_name)
+        names = group.installed().names()
+        off = field.metadata.get("off")
+        nothing = f", or `{off}` (none at all)" if off is not None else ""
+        return f"a registered {group.words}: {', '.join(f'`{n}`' for n in names)}{nothing}"
     text = describe(hint)
     bounds = implicit_bounds(key, field.metadata.get("bounds", Bounds())).describe()
     return f"{text} {bounds}".strip()

@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from cosim.core.recorder import EVENTS, MESSAGES
-from cosim.core.registry import AdapterRegistry
+from cosim.core.registry import installed_groups
 from cosim.core.table import TableSpec
 from cosim.runner.execute import REALTIME
 
@@ -26,7 +26,11 @@ class DocumentedTable:
 
 
 def documented_tables() -> list[DocumentedTable]:
-    """The recorder's tables, the real-time table, and every loadable adapter's ``tables``."""
+    """The recorder's tables, the real-time table, and every loadable entry's ``tables``.
+
+    Entries of every registry may write tables (an adapter, a network backend, ...); each
+    declares them in a ``tables`` class attribute.
+    """
     found = [
         DocumentedTable(
             MESSAGES, "the recorder (every run, unless record.messages = false)", "cosim"
@@ -34,10 +38,15 @@ def documented_tables() -> list[DocumentedTable]:
         DocumentedTable(EVENTS, "the recorder (every run)", "cosim"),
         DocumentedTable(REALTIME, "the runner (real-time runs)", "cosim"),
     ]
-    registry = AdapterRegistry.from_entry_points()
-    for name, adapter in registry.load_all().items():
-        for spec in getattr(adapter, "tables", ()):
-            found.append(DocumentedTable(spec, f"adapter `{name}`", registry.package(name)))
+    for group in installed_groups():
+        registry = group.installed()
+        for name, entry in registry.load_all().items():
+            specs = getattr(entry, "tables", ())
+            if not isinstance(specs, tuple):  # a settings section's key named "tables"
+                continue
+            for spec in (s for s in specs if isinstance(s, TableSpec)):
+                writer = f"{group.words} `{name}`"
+                found.append(DocumentedTable(spec, writer, registry.package(name)))
     return found
 
 

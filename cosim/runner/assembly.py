@@ -4,9 +4,8 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
 
-from cosim.core.adapter import Adapter, Driver, RunContext
+from cosim.core.adapter import DRIVERS, Adapter, Driver, RunContext
 from cosim.core.bus import Bus
 from cosim.core.errors import ConfigError
 from cosim.core.kernel import Kernel
@@ -20,13 +19,7 @@ from models.errors import ModelError
 
 def driver_registry() -> Registry[Driver]:
     """The robot drivers installed packages register (``cosim.drivers``)."""
-    return Registry.installed("driver", _driver_contract)
-
-
-def _driver_contract(name: str, loaded: Any) -> str | None:
-    if not isinstance(loaded, Driver):
-        return f"is a {type(loaded).__name__}; expected a cosim.core.adapter.Driver"
-    return None
+    return DRIVERS.installed()
 
 
 def adapter_names(scenario: Scenario, *, recording: bool = False) -> list[str]:

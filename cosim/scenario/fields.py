@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from typing import Any, Literal, TypeVar, Union, get_args, get_origin, get_type_hints
 
 from cosim.core.errors import ConfigError, ScenarioError
-from cosim.core.registry import Registry, suggest_names
+from cosim.core.registry import group_named, suggest_names
 from models.errors import ModelError
 
 
@@ -67,6 +67,7 @@ def param(
     lt: float | None = None,
     path: bool = False,
     registry: str | None = None,
+    off: str | None = None,
 ) -> Any:
     """Declare a configuration field with a default, a one-line doc and numeric bounds.
 
@@ -74,11 +75,19 @@ def param(
     scenario file when the scenario is loaded (against the working folder for presets and
     ``--set``), so the resolved scenario names an absolute file.
 
-    ``registry`` names a registry kind (``"protocol"``, ``"controller"``, ...: see
-    :data:`cosim.core.registry.GROUPS`): the value (or every element of a list) must be a
-    name registered there; an unknown one is refused with the registered names.
+    ``registry`` names the entry-point group of a registry (``"cosim.controllers"``: a
+    :class:`~cosim.core.registry.Group` registered in ``cosim.registries``): the value (or
+    every element of a list) must be a name registered there; an unknown one is refused
+    with the registered names. ``off`` is a value that chooses nothing (``"none"``: no
+    motion-capture source at all), accepted without being registered.
     """
-    metadata = {"doc": doc, "bounds": Bounds(ge, gt, le, lt), "path": path, "registry": registry}
+    metadata = {
+        "doc": doc,
+        "bounds": Bounds(ge, gt, le, lt),
+        "path": path,
+        "registry": registry,
+        "off": off,
+    }
     return field(default=default, metadata=metadata)
 
 
@@ -325,9 +334,9 @@ def build(
                 if isinstance(value, tuple):
                     expected += " (every element)"
                 raise ConfigError(format_problem(origin, section, key, raw, expected))
-        kind = fields[key].metadata.get("registry")
-        if kind is not None:
-            _check_registered(kind, value, origin, section, key, raw)
+        group = fields[key].metadata.get("registry")
+        if group is not None and value != fields[key].metadata.get("off"):
+            _check_registered(group, value, origin, section, key, raw)
         values[key] = value
     instance = cls(**values)
     problems = getattr(instance, "problems", None)
@@ -340,9 +349,11 @@ def build(
     return instance
 
 
-def _check_registered(kind: str, value: Any, origin: str, section: str, key: str, raw: Any) -> None:
-    """Refuse a name (or a list's name) that is not registered in the ``kind`` registry."""
-    registry = Registry.installed(kind)
+def _check_registered(
+    group: str, value: Any, origin: str, section: str, key: str, raw: Any
+) -> None:
+    """Refuse a name (or a list's name) that is not registered in the ``group`` registry."""
+    registry = group_named(group).installed()
     for name in value if isinstance(value, tuple) else (value,):
         if name not in registry:
             expected = f"a registered {registry.words}" + suggest_names(name, registry.names())

@@ -18,7 +18,7 @@ from types import MappingProxyType
 from typing import Any, TypeVar
 
 from cosim.core.errors import ConfigError, RegistryError
-from cosim.core.registry import Registry
+from cosim.core.registry import Group, Registry
 from cosim.scenario.fields import key_bounds
 from cosim.scenario.sections import (
     LidarConfig,
@@ -35,11 +35,6 @@ CORE_SECTIONS = ("scenario", "world", "robots", "lidar", "odometry", "record")
 """Sections every scenario has, whatever is installed."""
 
 
-def section_registry() -> Registry[type[Any]]:
-    """The settings sections installed packages register (``cosim.sections``)."""
-    return Registry.installed("section", _section_contract)
-
-
 def _section_contract(name: str, loaded: Any) -> str | None:
     """A section must be a dataclass type whose every field has a default."""
     import dataclasses
@@ -51,6 +46,23 @@ def _section_contract(name: str, loaded: Any) -> str | None:
     except TypeError as error:
         return f"cannot be built from defaults alone ({error}): give every key a default"
     return None
+
+
+SECTIONS = Group(
+    "cosim.sections",
+    "settings section",
+    "settings sections",
+    "a frozen dataclass of `param(default, doc, ...)` fields (`cosim.scenario.fields`)",
+    "a `[section]` of the scenario file",
+    named=False,
+    check=_section_contract,
+)
+"""Settings sections: a scenario file's ``[section]`` tables, each a frozen dataclass."""
+
+
+def section_registry() -> Registry[type[Any]]:
+    """The settings sections installed packages register (``cosim.sections``)."""
+    return SECTIONS.installed()
 
 
 @dataclass(frozen=True)

@@ -38,7 +38,9 @@ class ScenarioSection:
     duration_s: float = param(60.0, "simulated time to run (s)", gt=0, le=1e7)
     seed: int = param(1, "scenario seed; every random stream derives from it", ge=0)
     adapters: tuple[str, ...] = param(
-        (), "extra adapters to start, by registered name (`cosim plugins`)", registry="adapter"
+        (),
+        "extra adapters to start, by registered name (`cosim plugins`)",
+        registry="cosim.adapters",
     )
 
     def problems(self) -> Iterator[Problem]:
@@ -106,7 +108,7 @@ class RobotsConfig:
         "assignment over the network driving through navigation), 'navigation' (to random "
         "reachable goals, the Nav2 role), 'waypoints' (straight lines, no avoidance) or "
         "'wander' (reactive lidar wandering)",
-        registry="driver",
+        registry="cosim.drivers",
     )
 
     def problems(self) -> Iterator[Problem]:

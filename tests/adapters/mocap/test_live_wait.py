@@ -41,15 +41,16 @@ def live_run(tmp_path: Path, system: str, host: str, timeout_s: float):
     )
 
 
-def workers() -> list[str]:
-    """Command lines of feed workers still running (any run's)."""
+def workers(parent: int | None = None) -> list[str]:
+    """Command lines of feed workers still running (any run's, or ``parent``'s children)."""
     found = []
     for proc in Path("/proc").iterdir():
         try:
             cmdline = (proc / "cmdline").read_bytes().replace(b"\0", b" ").decode()
-        except OSError:
+            ppid = int((proc / "stat").read_text().rsplit(")", 1)[1].split()[1])
+        except (OSError, ValueError, IndexError):
             continue
-        if "feed_worker.py" in cmdline:
+        if "feed_worker.py" in cmdline and parent in (None, ppid):
             found.append(cmdline)
     return found
 
@@ -126,9 +127,10 @@ def test_ctrl_c_while_waiting_for_a_mocap_server_stops_the_run_at_once_keeping_w
     command += ["--out", str(out)]
     process = subprocess.Popen(command, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 20.0
-    while not workers() and time.monotonic() < deadline:  # the run is waiting on the system
+    # the run is waiting on the system (other tests' runs may have workers of their own)
+    while not workers(process.pid) and time.monotonic() < deadline:
         time.sleep(0.05)
-    assert workers()
+    assert workers(process.pid)
     time.sleep(0.5)
     process.send_signal(signal.SIGINT)
     stopped = time.monotonic()

@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from adapters.mocap.tracks import TrackError, read_csv_track, read_pose_track, yaw_of
+from adapters.bags.tracks import TrackError, read_csv_track, read_pose_track, yaw_of
 from cosim.core.errors import BagError
 from tests.conftest import SHARED_DATA
 

@@ -4,7 +4,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from adapters.mocap.tracking import external_bodies, physical_robots, tracked_robots
+from adapters.mocap.tracking import tracked_bodies, tracked_robots
+from adapters.physical.bridge import physical_robots
 from cosim import load_scenario
 from cosim.core.errors import ConfigError
 
@@ -62,7 +63,7 @@ def test_a_ros2_source_tracks_each_physical_robot_on_the_topic_pattern():
             "physical.robots": ["robot_2"],
         }
     )
-    assert external_bodies(s, NAMES) == [("robot_2", "/vicon/robot_2/robot_2")]
+    assert tracked_bodies(s, NAMES) == [("robot_2", "/vicon/robot_2/robot_2")]
     assert physical_robots(s, NAMES) == ["robot_2"]
     assert tracked_robots(s, NAMES) == ["robot_2"]
 

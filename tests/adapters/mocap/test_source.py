@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import cosim
+from adapters.bags.tracks import read_pose_track
 from adapters.mocap.intake import PoseIntake
-from adapters.mocap.tracks import read_pose_track
 from cosim.core.errors import BagError, ConfigError
 from cosim.recording.dataframes import table_frame
 from cosim.runner.assembly import assemble

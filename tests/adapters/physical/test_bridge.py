@@ -13,8 +13,8 @@ from cyclonedds.idl.annotations import final
 
 import cosim
 from adapters.physical.bridge import SilentRobotError
+from adapters.physical.domain import claim_run_domain
 from adapters.physical.launcher import Standins, standin_command
-from adapters.ros2dds.domain import claim_run_domain
 from adapters.ros2dds.participant import RosParticipant
 from adapters.ros2dds.qos import QosKind
 from adapters.ros2dds.types import Header, Odometry, Point, Pose, PoseWithCovariance, Quaternion

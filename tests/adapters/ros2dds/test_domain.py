@@ -14,7 +14,6 @@ from adapters.ros2dds.domain import (
     LOCK_DIR,
     bound_port,
     claim_domain,
-    claim_run_domain,
     discovery_ports,
 )
 from adapters.ros2dds.participant import RosParticipant
@@ -96,22 +95,6 @@ def test_a_process_claiming_its_own_named_domain_again_shares_the_claim():
         again.release()  # holds no lock of its own: the first claim still holds
         text = (LOCK_DIR / f"domain-{claim.domain}.lock").read_text()
         assert text.strip() == str(os.getpid())
-
-
-def test_a_run_domain_resolves_the_scenario_and_says_where_a_robot_joins():
-    scenario = cosim.load_scenario("lab-real-in-virtual")
-    assert scenario.physical.dds_domain == "auto"
-    with claim_run_domain(scenario) as run_domain:
-        domain = run_domain.claim.domain
-        assert run_domain.scenario.physical.dds_domain == domain
-        assert run_domain.claim.describe() == (
-            f"DDS domain {domain} on loopback (chosen for this run; a robot joins with "
-            f"ROS_DOMAIN_ID={domain})"
-        )
-
-
-def test_a_scenario_without_dds_claims_no_domain():
-    assert claim_run_domain(cosim.load_scenario("lab-room")) is None
 
 
 def test_auto_with_a_network_interface_is_refused_at_load_naming_both_keys():

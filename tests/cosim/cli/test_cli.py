@@ -285,7 +285,7 @@ def test_wander_without_a_lidar_is_refused_naming_the_keys(tmp_path):
         ("network.loss_prob=1.5", "[network] loss_prob = 1.5: expected a number >= 0 and <= 1"),
         ("network.ge_p=-0.1", "[network] ge_p = -0.1: expected a number >= 0 and <= 1"),
         ("network.profile=wifi_bad", "profile = 'wifi_bad': expected one of 'ideal'"),
-        ("network.topology=star", "topology = 'star': expected one of 'complete'"),
+        ("network.topology=star", "topology = 'star': expected a registered network topology"),
         ("network.loss_prob=0.2", "loss_prob = 0.2: expected 0 with loss_model 'none'"),
         (
             'network.partitions=[{from_s=1.0, to_s=2.0, hosts=["robot_42"]}]',

@@ -76,8 +76,9 @@ def test_plugins_lists_every_registry_with_its_package_and_a_line_of_description
 
 def test_plugins_can_list_one_registry_and_refuses_an_unknown_one():
     assert cosim_main("plugins", "planner").stdout.splitlines()[0].startswith("global planners")
-    done = cosim_main("plugins", "protocols")
-    assert done.returncode == 2 and "'protocols' is not a registry" in done.stderr
+    assert cosim_main("plugins", "cosim.protocols").stdout.startswith("assignment protocols")
+    done = cosim_main("plugins", "protokols")
+    assert done.returncode == 2 and "'protokols' is not a registry" in done.stderr
 
 
 @pytest.mark.slow

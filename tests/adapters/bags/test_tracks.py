@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.typesys import Stores, get_typestore
 
-from adapters.mocap.tracks import TrackError, read_pose_track
+from adapters.bags.tracks import TrackError, read_pose_track
 from cosim.core.errors import BagError
 from tests.conftest import SHARED_DATA
 

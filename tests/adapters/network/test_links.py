@@ -9,7 +9,7 @@ import pytest
 
 import cosim
 from adapters.naming import topic
-from adapters.network.link import NetworkLink
+from adapters.network.links import ModelLink
 from cosim.core.adapter import RunContext
 from cosim.core.errors import ConfigError
 from cosim.core.hosts import BASE_HOST, HostId
@@ -235,7 +235,7 @@ def test_the_link_over_an_ideal_network_stands_for_the_transfers_of_its_links():
     the same network forced through its links."""
     hosts = [HostId(f"h{i}") for i in range(4)]
 
-    def link(forced: bool) -> NetworkLink:
+    def link(forced: bool) -> ModelLink:
         model = NetworkModel(
             LinkParams(latency=ConstantLatency(3.0), loss_factory=NoLoss),
             streams=RngStreams(1).stream,
@@ -244,7 +244,7 @@ def test_the_link_over_an_ideal_network_stands_for_the_transfers_of_its_links():
         )
         if forced:
             model.set_edges(frozenset(complete(hosts)))
-        return NetworkLink(model, lambda a, b: None)
+        return ModelLink(model, lambda a, b: None)
 
     fast, forced = link(False), link(True)
     for k in range(40):

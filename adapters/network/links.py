@@ -1,11 +1,13 @@
-"""The network adapter: every inter-host message crosses the network model.
+"""The built-in network backend ``links``: every link modelled by itself.
 
-It builds :class:`models.network.model.NetworkModel` from ``[network]``, installs it as
-the bus's link, feeds it the robots' ground-truth positions for range and path loss,
-records link changes (topology, range, partitions) in ``tables/links``, and offers a
-:class:`NetworkView` (who can hear whom right now) to protocols. Robots talk to each other
-along the topology; the base station (and any host without a position) reaches every
-robot, subject to latency, loss, bandwidth and partitions.
+It builds :class:`models.network.model.NetworkModel` from ``[network]``: the latency,
+loss model and topology chosen there (registered in ``cosim.latency_models``,
+``cosim.loss_models`` and ``cosim.topologies``), bandwidth and interface queues, range or
+path loss, and scheduled partitions. It feeds the model the robots' ground-truth positions
+for range and path loss and records link changes (topology, range, partitions) in
+``tables/links``. Robots talk to each other along the topology; the base station (and any
+host without a position) reaches every robot, subject to latency, loss, bandwidth and
+partitions.
 """
 
 from __future__ import annotations
@@ -13,23 +15,36 @@ from __future__ import annotations
 import functools
 from array import array
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any, ClassVar
+from typing import Any, ClassVar, TypeVar
 
 import numpy as np
 
+from adapters.network.contract import (
+    LATENCY_MODELS,
+    LOSS_MODELS,
+    TOPOLOGIES,
+    LatencyChoice,
+    LossChoice,
+    NetworkContext,
+    TopologyChoice,
+)
 from adapters.network.settings import NetworkConfig
-from adapters.network.setup import build_model, build_topology, partitions_of
 from cosim.core.adapter import RunContext
 from cosim.core.errors import ConfigError
 from cosim.core.hosts import HostId, HostKind
 from cosim.core.kernel import Stage
 from cosim.core.link import AllDelivered, DeliveryStatus, Transfer
 from cosim.core.table import TableSpec
-from cosim.core.timebase import NS_PER_S, period_ns
+from cosim.core.timebase import NS_PER_S, period_ns, s_to_ns
+from cosim.scenario.fields import model_problem
+from models.errors import ModelError
 from models.fleet.kinematics import FleetState
 from models.network.fate import Fate
-from models.network.model import NetworkModel, Partition
+from models.network.model import LinkParams, NetworkModel, Partition
+from models.network.radio import PathLoss
 from models.network.topology import Edges, edge
+
+T = TypeVar("T")
 
 LINKS = TableSpec(
     "links",
@@ -46,8 +61,68 @@ LINK_COLUMNS = tuple(LINKS.columns)
 _STATUS = {fate: DeliveryStatus(fate.value) for fate in Fate}
 
 
-class NetworkLink:
-    """The bus's :class:`cosim.core.link.Link`, backed by the network model."""
+def _checked(source: str, make: Callable[[], T]) -> T:
+    """Run a model constructor, turning its ModelError into one line naming the file."""
+    try:
+        return make()
+    except ModelError as error:
+        raise model_problem(source, error) from None
+
+
+def partitions_of(cfg: NetworkConfig) -> list[Partition]:
+    """The scheduled partitions, in kernel time."""
+    return [
+        Partition(
+            from_ns=s_to_ns(p.from_s),
+            to_ns=s_to_ns(p.to_s),
+            hosts=frozenset(p.hosts),
+            links=frozenset((a, b) for a, b in p.links),
+        )
+        for p in cfg.partitions
+    ]
+
+
+def build_model(context: NetworkContext, partitions: list[Partition]) -> NetworkModel:
+    """The network model of a scenario, with its latency and loss models chosen by name."""
+    cfg, run = context.network, context.run
+    latency: LatencyChoice = LATENCY_MODELS.installed().get(cfg.latency_model)(context)
+    loss: LossChoice = LOSS_MODELS.installed().get(cfg.loss_model)(context)
+    path_loss = None
+    if cfg.path_loss:
+        path_loss = PathLoss(
+            tx_power_dbm=cfg.tx_power_dbm,
+            ref_loss_db=cfg.ref_loss_db,
+            exponent=cfg.path_loss_exponent,
+            sensitivity_dbm=cfg.sensitivity_dbm,
+            shadowing_db=cfg.shadowing_db,
+        )
+    params = LinkParams(
+        latency=latency.model(),
+        loss_factory=loss.factory(),
+        reorder=cfg.reorder,
+        path_loss=path_loss,
+        range_m=cfg.range_m if cfg.range_m > 0 else None,
+    )
+    bandwidth = cfg.bandwidth_mbps * 1e6 if cfg.bandwidth_mbps > 0 else None
+    return NetworkModel(
+        params,
+        streams=run.rng.stream,
+        bandwidth_bps=bandwidth,
+        queue_packets=cfg.queue_packets,
+        partitions=partitions,
+    )
+
+
+class ModelLink:
+    """A :class:`cosim.core.link.Link` deciding by a network model, latencies kept.
+
+    Args:
+        model: the network model.
+        distance_m: the distance between two hosts (m), None for a host without a place.
+
+    Attributes:
+        latencies_ns: the latency of every delivered copy (ns), in delivery decision order.
+    """
 
     def __init__(self, model: NetworkModel, distance_m: Callable[[str, str], float | None]):
         self.model = model
@@ -71,55 +146,28 @@ class NetworkLink:
         return out
 
 
-class NetworkView:
-    """Who can hear whom, now: the topology minus range and active partitions.
+class LinksBackend(ModelLink):
+    """Per-link latency, loss, bandwidth and queues, range and partitions (see the module)."""
 
-    Args:
-        adapter: the network adapter (holds topology, positions, partitions).
-    """
-
-    def __init__(self, adapter: NetworkAdapter) -> None:
-        self._adapter = adapter
-
-    def up_links(self, t_ns: int) -> Edges:
-        """Every undirected link that is up at ``t_ns`` (sorted host pairs)."""
-        return self._adapter.links_at(t_ns)
-
-    def neighbors(self, host: str, t_ns: int) -> list[str]:
-        """Hosts that ``host`` has a link to at ``t_ns``, sorted."""
-        up = self._adapter.links_at(t_ns)
-        return sorted(b if a == host else a for a, b in up if host in (a, b))
-
-    def robot_graph(self) -> tuple[list[str], Edges]:
-        """The robots and the topology edges among them (no range, no partitions)."""
-        return list(self._adapter.robots), self._adapter.topology
-
-
-class NetworkAdapter:
-    """Builds the network model, installs it on the bus and records links."""
-
-    name: ClassVar[str] = "network"
-    requires: ClassVar[tuple[str, ...]] = ("world", "fleet")
+    name: ClassVar[str] = "links"
     tables: ClassVar[tuple[TableSpec, ...]] = (LINKS,)
-    """The tables it writes (documented in the table reference)."""
 
-    def __init__(self, run: RunContext) -> None:
-        cfg = run.settings(NetworkConfig)
+    def __init__(self, context: NetworkContext) -> None:
+        run, cfg = context.run, context.network
         self.fleet = run.service(FleetState)
-        self.robots = list(self.fleet.names)
+        self.robots = list(context.robots)
         self._index = {name: i for i, name in enumerate(self.robots)}
         self.source = run.scenario.source
         self.partitions: list[Partition] = partitions_of(cfg)
-        self.model = build_model(cfg, run, self.partitions)
-        self.topology = build_topology(cfg, self.robots, run)
+        model = _checked(self.source, lambda: build_model(context, self.partitions))
+        super().__init__(model, self._distance_m)
+        choice: TopologyChoice = TOPOLOGIES.installed().get(cfg.topology)(context)
+        self.topology = _checked(self.source, choice.edges)
         self.range_m = cfg.range_m if cfg.range_m > 0 else None
-        self.link = NetworkLink(self.model, self._distance_m)
-        run.bus.link = self.link
         self.table = run.recorder.table(LINKS)
         self.update_ns = period_ns(cfg.topology_update_hz)
         self._state: Edges = frozenset()
         self.changes = 0
-        run.provide(NetworkView(self))
         run.check_when_assembled(lambda: self._check_partition_hosts(run))
 
     def _distance_m(self, a: str, b: str) -> float | None:
@@ -129,9 +177,6 @@ class NetworkAdapter:
             return None
         fleet = self.fleet
         return float(np.hypot(fleet.x[i] - fleet.x[j], fleet.y[i] - fleet.y[j]))
-
-    def _infrastructure(self, run: RunContext) -> list[str]:
-        return [h for h, host in run.hosts.items() if host.kind is not HostKind.ROBOT]
 
     def _check_partition_hosts(self, run: RunContext) -> None:
         known = set(run.hosts)
@@ -145,7 +190,9 @@ class NetworkAdapter:
 
     def start(self, run: RunContext) -> None:
         """Set the topology and record the links now and whenever they change."""
-        self.infrastructure = self._infrastructure(run)
+        self.infrastructure = [
+            h for h, host in run.hosts.items() if host.kind is not HostKind.ROBOT
+        ]
         # every pair of robots linked: the topology's edges are pairs of distinct robots,
         # so n (n - 1) / 2 of them are all pairs (no 500,000-edge set built to compare)
         robots, n = set(self.robots), len(self.robots)
@@ -178,6 +225,10 @@ class NetworkAdapter:
             up = {(a, b) for a, b in up if not any(p.separates(a, b) for p in active)}
         return frozenset(up)
 
+    def robot_graph(self) -> tuple[list[str], Edges]:
+        """The robots and the topology's edges (no range, no partitions)."""
+        return list(self.robots), self.topology
+
     def _update(self, now_ns: int) -> None:
         state = self.links_at(now_ns)
         went_up = sorted(state - self._state)
@@ -196,7 +247,7 @@ class NetworkAdapter:
 
     def finish(self, run: RunContext) -> Mapping[str, Any]:
         """Latency percentiles (ms) of delivered inter-host messages, and link changes."""
-        latencies = np.frombuffer(self.link.latencies_ns, dtype=np.int64) / 1e6
+        latencies = np.frombuffer(self.latencies_ns, dtype=np.int64) / 1e6
         summary: dict[str, Any] = {
             "link_changes": self.changes,
             # the long-run loss of each link's loss process as configured (not measured)
