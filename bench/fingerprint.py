@@ -81,6 +81,15 @@ CASES: dict[str, list[str]] = {
         "--set",
         "mocap.source='simulated'",
     ],
+    "hungarian-degraded": [
+        "warehouse-rows",
+        "--duration-s",
+        "30",
+        "--set",
+        "assignment.protocol='hungarian'",
+        "--set",
+        "network.profile='wifi_degraded'",
+    ],
     "greedy-range-pathloss": [
         "warehouse-rows",
         "--duration-s",

@@ -17,8 +17,9 @@ from dataclasses import dataclass, field
 
 from adapters.assignment.contract import ProtocolAgent
 from adapters.assignment.tables import DtaRecords
-from adapters.assignment.topics import ASSIGNMENT, CLAIMS, DONE, SERVICE_REQUESTS
+from adapters.assignment.topics import ASSIGNMENT
 from adapters.naming import topic
+from adapters.tasks.topics import CLAIMS, DONE, SERVICE_REQUESTS
 from cosim.core.adapter import RunContext
 from cosim.core.hosts import HostId
 from cosim.core.messages import (

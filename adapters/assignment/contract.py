@@ -195,17 +195,6 @@ class ProtocolBase:
         return {}
 
 
-@dataclass(frozen=True)
-class ProtocolInUse:
-    """The run's assignment protocol (a service: the task source asks a central one for orders).
-
-    Attributes:
-        protocol: the protocol instance the robots run.
-    """
-
-    protocol: AssignmentProtocolType
-
-
 PROTOCOLS = Group(
     "cosim.protocols",
     "assignment protocol",

@@ -27,13 +27,16 @@ from adapters.assignment.commitments import Commitments, RobotTasks
 from adapters.assignment.contract import (
     EpochView,
     ProtocolFleet,
-    ProtocolInUse,
     protocol_registry,
 )
 from adapters.assignment.settings import AssignmentConfig
 from adapters.assignment.tables import ASSIGNMENTS, DtaRecords
-from adapters.assignment.topics import (
-    ASSIGNMENT,
+from adapters.assignment.topics import ASSIGNMENT
+from adapters.naming import topic
+from adapters.network.contract import NetworkView
+from adapters.tasks.contract import CentralOrders
+from adapters.tasks.settings import TasksConfig
+from adapters.tasks.topics import (
     CLAIMS,
     DONE,
     REPORTS,
@@ -43,9 +46,6 @@ from adapters.assignment.topics import (
     order_topic,
     reply_topic,
 )
-from adapters.naming import topic
-from adapters.network.contract import NetworkView
-from adapters.tasks.settings import TasksConfig
 from cosim.core.adapter import RunContext
 from cosim.core.bus import Envelope
 from cosim.core.hosts import HostId
@@ -103,7 +103,8 @@ class DtaAdapter:
             run, tuple(self.names), self.diameter, run.service(Warehouse).size_m
         )
         self.protocol = protocol_type(fleet_view)
-        run.provide(ProtocolInUse(self.protocol))
+        if protocol_type.central:
+            run.provide(CentralOrders(self.protocol))
         self.records = DtaRecords(
             run.recorder, self.names, compare=protocol_type.compare_to_optimum
         )

@@ -5,6 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import ClassVar, Literal
 
+from adapters.tasks.contract import ClaimRules
+from cosim.core.registry import group_named
 from cosim.scenario.fields import param
 
 
@@ -43,3 +45,13 @@ class AssignmentConfig:
     rebroadcast_s: float = param(
         1.0, "period of re-sending task sets, claims and unchanged protocol state (s)", gt=0
     )
+
+    def claim_rules(self) -> ClaimRules:
+        """How the task source keeps its book (:mod:`adapters.tasks.contract`)."""
+        central = group_named("cosim.protocols").installed().get(self.protocol).central
+        return ClaimRules(
+            claim_timeout_s=self.claim_timeout_s,
+            rebroadcast_s=self.rebroadcast_s,
+            preemption=self.preemption,
+            central=bool(central),
+        )

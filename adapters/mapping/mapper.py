@@ -8,13 +8,10 @@ localize; every ``mapping.map_update_interval_s`` it publishes its map on
 ``/robot_i/map`` (nav_msgs/OccupancyGrid), which its navigation plans on, as
 slam_toolbox's ``/map`` feeds Nav2's static layer.
 
-Sharing (``mapping.share``), over the network model like any message: ``scans`` sends
-every mapped scan with its estimated pose on ``/fleet/mapping/scans`` and a neighbour
-adds it to its map at that pose; ``maps`` sends, every ``mapping.share_period_s``, the
-log-odds the robot's own scans added since its last update, compressed
-(:mod:`models.mapping.exchange`), on ``/fleet/mapping/updates``. Robots start with known
-poses in the common ``map`` frame. A lost message is not sent again: its evidence is
-lost, as with slam_toolbox.
+What robots send their neighbours of what they map is the registered sharing mode
+``mapping.share`` names (:mod:`adapters.mapping.sharing`: ``none``, ``scans``, ``maps``).
+With the navigation's robots layer (:mod:`adapters.fleet.robots_layer`), each robot leaves
+returns off the robots it heard of out of its map and its matching.
 """
 
 from __future__ import annotations
@@ -25,35 +22,31 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from adapters.fleet.robots_layer import RobotsLayer
+from adapters.mapping.contract import MAP_SHARING, MapSharing, SharingContext
 from adapters.mapping.geometry import map_geometry
 from adapters.mapping.settings import MappingConfig
 from adapters.mapping.tables import MAP_MERGES, MAP_QUALITY, SCAN_MATCHES, MappingRecords
+from adapters.mapping.topics import FLEET_MAP, correction_topic, map_topic
 from adapters.naming import topic
-from adapters.navigation.robots_layer import ROBOT_STATES
-from adapters.navigation.settings import NavigationConfig
 from cosim.core.adapter import RunContext
 from cosim.core.bus import Envelope, TopicQos
 from cosim.core.hosts import BASE_HOST, HostId
 from cosim.core.kernel import Stage
 from cosim.core.messages import (
     LaserScan,
-    LocalizedScan,
-    MapUpdate,
     Message,
     OccupancyGrid,
     Odometry,
-    RobotState,
     TFMessage,
     Transform,
 )
 from cosim.core.table import TableSpec
-from cosim.core.timebase import period_ns, s_to_ns
+from cosim.core.timebase import period_ns
 from cosim.scenario.sections import LidarConfig
 from models.arrays import FloatArray
-from models.errors import ModelError
 from models.fleet.kinematics import FleetState
 from models.geometry.occupancy import OccupancyGrid as Grid
-from models.mapping.exchange import PackedUpdate, pack, unpack
 from models.mapping.grid import LogOddsMap, Scratch, merged
 from models.mapping.loops import LoopParams
 from models.mapping.matcher import MatcherParams
@@ -61,9 +54,6 @@ from models.mapping.slam import MapperParams, ScanMapper, UpdateGate
 from models.sensing.lidar import ScanGeometry
 from models.world.warehouse import Warehouse
 
-SCANS = "/fleet/mapping/scans"
-UPDATES = "/fleet/mapping/updates"
-FLEET_MAP = "/fleet/map"
 ROBOT_MARGIN_M = 0.15
 """Returns this close to a robot's disc are taken as the robot's (m): pose age and noise."""
 
@@ -125,7 +115,8 @@ class MappingAdapter:
         ).angles()
         self.geometry = map_geometry(world, self.cfg.resolution_m)
         scratch = Scratch(self.geometry)
-        track = self.cfg.share == "maps"
+        sharing = MAP_SHARING.installed().get(self.cfg.share)
+        track = sharing.tracks_changes
         self.maps = [
             LogOddsMap(self.geometry, scratch=scratch, track_changes=track) for _ in self.names
         ]
@@ -135,42 +126,40 @@ class MappingAdapter:
             for grid, (x, y, yaw) in zip(self.maps, world.starts, strict=True)
         ]
         self.odom = [(float(x), float(y), float(yaw)) for x, y, yaw in world.starts]
-        self.seq = [0] * len(self.names)
         self.records = MappingRecords(run.recorder, self.names, world, self.geometry)
-        self.tf_topics = [topic(n, "tf") for n in self.names]
-        self.map_topics = [topic(n, "map") for n in self.names]
+        self.tf_topics = [correction_topic(n) for n in self.names]
+        self.map_topics = [map_topic(n) for n in self.names]
         bus = run.bus
         for tf, grid in zip(self.tf_topics, self.map_topics, strict=True):
             bus.advertise(tf, TFMessage)
             bus.advertise(grid, OccupancyGrid, TopicQos.LATCHED)
         bus.advertise(FLEET_MAP, OccupancyGrid, TopicQos.LATCHED)
-        if self.cfg.share == "scans":
-            bus.advertise(SCANS, LocalizedScan, TopicQos.SENSOR)
-        elif self.cfg.share == "maps":
-            bus.advertise(UPDATES, MapUpdate)
+        context = SharingContext(
+            run,
+            self.cfg,
+            self.names,
+            self.hosts,
+            self.maps,
+            self.geometry,
+            self.params,
+            self.records,
+        )
+        self.sharing: MapSharing = sharing(context)
         self.recorder = run.recorder
-        nav = run.settings(NavigationConfig)
         # with a robots layer each robot hears where the others are: returns off them are
         # left out of its map and its matching (robots are not the building); whether one
-        # runs is known once every adapter is built (the navigation advertises it)
-        self.robots_layer = nav.robots_layer
-        self.others: list[dict[str, tuple[float, float, float, int]]] = [{} for _ in self.names]
-        self.others_timeout_ns = s_to_ns(nav.robots_layer_timeout_s)
+        # runs is known once every adapter is built (the navigation provides it)
+        self.robots_layer: RobotsLayer | None = None
 
     # -- wiring ----------------------------------------------------------------------
     def start(self, run: RunContext) -> None:
-        """Follow every robot's odometry and scans; start publishing and sampling."""
+        """Follow every robot's odometry and scans; start publishing, sharing and sampling."""
         bus = run.bus
-        self.robots_layer = self.robots_layer and ROBOT_STATES in bus.advertised()
+        if run.has_service(RobotsLayer):
+            self.robots_layer = run.service(RobotsLayer)
         for i, (name, host) in enumerate(zip(self.names, self.hosts, strict=True)):
             bus.subscribe(topic(name, "odom"), host, self._on_odom(i))
             bus.subscribe(topic(name, "scan"), host, self._on_scan(run, i))
-            if self.robots_layer:
-                bus.subscribe(ROBOT_STATES, host, self._on_robot_state(i))
-            if self.cfg.share == "scans":
-                bus.subscribe(SCANS, host, self._on_shared_scan(run, i))
-            elif self.cfg.share == "maps":
-                bus.subscribe(UPDATES, host, self._on_update(run, i))
         kernel = run.kernel
         interval = period_ns(1.0 / self.cfg.map_update_interval_s)
         kernel.every(
@@ -179,14 +168,7 @@ class MappingAdapter:
             stage=Stage.CONTROL,
             start_ns=kernel.now_ns + interval,
         )
-        if self.cfg.share == "maps":
-            share = period_ns(1.0 / self.cfg.share_period_s)
-            kernel.every(
-                share,
-                lambda now: self._share_maps(run, now),
-                stage=Stage.CONTROL,
-                start_ns=kernel.now_ns + share,
-            )
+        self.sharing.start(run)
         quality = period_ns(1.0 / self.cfg.quality_period_s)
         kernel.every(quality, self._sample, stage=Stage.RECORD, start_ns=kernel.now_ns + quality)
 
@@ -204,31 +186,11 @@ class MappingAdapter:
 
         return on_scan
 
-    def _on_robot_state(self, i: int) -> Callable[[Message, Envelope], None]:
-        me = self.names[i]
-        known = self.others[i]
-
-        def on_state(message: Message, envelope: Envelope) -> None:
-            assert isinstance(message, RobotState)
-            if message.robot != me:
-                known[message.robot] = (
-                    message.x_m,
-                    message.y_m,
-                    message.radius_m,
-                    envelope.t_recv_ns,
-                )
-
-        return on_state
-
-    def _without_robots(self, i: int, now_ns: int, ranges: FloatArray) -> FloatArray:
+    def _without_robots(
+        self, layer: RobotsLayer, i: int, now_ns: int, ranges: FloatArray
+    ) -> FloatArray:
         """The scan with returns off robots it heard of (recently) set to NaN (ignored)."""
-        discs = np.array(
-            [
-                (x, y, r)
-                for x, y, r, t in self.others[i].values()
-                if now_ns - t <= self.others_timeout_ns
-            ]
-        ).reshape(-1, 3)
+        discs = layer.discs(i, now_ns)
         if not len(discs):
             return ranges
         x, y, yaw = self.mappers[i].estimate(self.odom[i])
@@ -247,8 +209,10 @@ class MappingAdapter:
         if not mapper.due(now, odom):
             return
         ranges = scan.ranges_m
-        if self.robots_layer:
-            ranges = self._without_robots(i, now, ranges.astype(np.float64)).astype(np.float32)
+        if self.robots_layer is not None:
+            ranges = self._without_robots(
+                self.robots_layer, i, now, ranges.astype(np.float64)
+            ).astype(np.float32)
         update = mapper.process(now, odom, ranges)
         if update is None:
             return
@@ -261,109 +225,7 @@ class MappingAdapter:
         name = self.names[i]
         tf = TFMessage(now, (Transform("map", f"{name}/odom", *correction),))
         run.bus.publish(self.tf_topics[i], tf, self.hosts[i])
-        if self.cfg.share == "scans":
-            x, y, yaw = update.pose
-            shared = LocalizedScan(
-                now,
-                name,
-                x,
-                y,
-                yaw,
-                scan.angle_min_rad,
-                scan.angle_increment_rad,
-                scan.range_min_m,
-                scan.range_max_m,
-                scan.ranges_m,
-            )
-            self.records.shared(shared.size_bytes())
-            run.bus.publish(SCANS, shared, self.hosts[i])
-
-    # -- neighbours' evidence -------------------------------------------------------------
-    def _on_shared_scan(self, run: RunContext, i: int) -> Callable[[Message, Envelope], None]:
-        me = self.names[i]
-
-        def on_scan(message: Message, envelope: Envelope) -> None:
-            assert isinstance(message, LocalizedScan)
-            if message.robot == me:
-                return
-            angles = message.angle_min_rad + message.angle_increment_rad * np.arange(
-                len(message.ranges_m), dtype=np.float64
-            )
-            cells = self.maps[i].integrate(
-                (message.x_m, message.y_m, message.yaw_rad),
-                angles,
-                message.ranges_m,
-                range_min_m=message.range_min_m,
-                range_max_m=message.range_max_m,
-                clear_no_return_m=self.params.clear_no_return_m,
-            )
-            self.records.merge(
-                run.kernel.now_ns,
-                i,
-                message.robot,
-                "scan",
-                message.size_bytes(),
-                message.stamp_ns,
-                cells,
-            )
-
-        return on_scan
-
-    def _share_maps(self, run: RunContext, now_ns: int) -> None:
-        for i, grid in enumerate(self.maps):
-            changes = grid.take_changes()
-            packed = pack(changes) if changes is not None else None
-            if packed is None:
-                continue
-            self.seq[i] += 1
-            update = MapUpdate(
-                now_ns,
-                self.names[i],
-                self.seq[i],
-                packed.ix0,
-                packed.iy0,
-                packed.width,
-                packed.height,
-                packed.scale,
-                packed.data,
-            )
-            self.records.shared(update.size_bytes())
-            run.bus.publish(UPDATES, update, self.hosts[i])
-
-    def _on_update(self, run: RunContext, i: int) -> Callable[[Message, Envelope], None]:
-        me = self.names[i]
-        grid = self.maps[i]
-        shape = (self.geometry.height, self.geometry.width)
-
-        def on_update(message: Message, envelope: Envelope) -> None:
-            assert isinstance(message, MapUpdate)
-            if message.robot == me:
-                return
-            packed = PackedUpdate(
-                message.ix0,
-                message.iy0,
-                message.width,
-                message.height,
-                message.scale,
-                message.data,
-            )
-            try:
-                block = unpack(packed, shape)
-            except ModelError as error:  # a malformed update is ignored, and counted
-                run.recorder.event(run.kernel.now_ns, me, "map_update_refused", str(error))
-                return
-            cells = grid.add_logodds(message.iy0, message.ix0, block)
-            self.records.merge(
-                run.kernel.now_ns,
-                i,
-                message.robot,
-                "map",
-                message.size_bytes(),
-                message.stamp_ns,
-                cells,
-            )
-
-        return on_update
+        self.sharing.mapped(run, i, update.pose, scan)
 
     # -- maps out --------------------------------------------------------------------------
     def _publish_maps(self, run: RunContext, now_ns: int) -> None:

@@ -12,7 +12,11 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import ClassVar, Literal
 
+from cosim.scenario.choices import choice_problems
 from cosim.scenario.fields import Problem, param
+
+NO_SHARING = "none"
+"""``mapping.share`` of robots that send their neighbours nothing (the default)."""
 
 
 @dataclass(frozen=True)
@@ -32,10 +36,12 @@ class MappingConfig:
         "correct odometry by correlative scan-to-map matching (Olson 2009), or none "
         "(odometry only, for comparison)",
     )
-    share: Literal["none", "scans", "maps"] = param(
-        "none",
-        "what robots send their neighbours over the network: nothing, their localized "
-        "scans (as slam_toolbox's multi-robot mode), or compressed map updates",
+    share: str = param(
+        NO_SHARING,
+        "what robots send their neighbours over the network, a registered map sharing mode: "
+        "none, scans (their localized scans, as slam_toolbox's multi-robot mode) or maps "
+        "(compressed map updates)",
+        registry="cosim.map_sharing",
     )
     min_travel_m: float = param(0.5, "distance driven before a scan updates the map (m)", ge=0)
     min_heading_rad: float = param(0.5, "or rotation before a scan updates the map (rad)", ge=0)
@@ -87,25 +93,20 @@ class MappingConfig:
     def problems(self) -> Iterator[Problem]:
         """Refuse settings that cannot work together.
 
-        A map finer than 1 cm would be very large; rebuilt maps cannot be sent as updates;
-        robots that do not map share nothing.
+        A map finer than 1 cm would be very large; robots that do not map share nothing;
+        the sharing mode may refuse settings of its own (rebuilt maps cannot be sent as
+        updates).
         """
         if self.resolution_m < 0.01:
             yield Problem("resolution_m", self.resolution_m, "a cell size >= 0.01 m")
-        if not self.enabled and self.share != "none":
+        if not self.enabled and self.share != NO_SHARING:
             yield Problem(
                 "share",
                 self.share,
-                "'none' with enabled = false (robots that do not map have nothing to share); "
-                "or set mapping.enabled = true",
+                f"{NO_SHARING!r} with enabled = false (robots that do not map have nothing to "
+                "share); or set mapping.enabled = true",
             )
-        if self.loop_closure and self.share == "maps":
-            yield Problem(
-                "loop_closure",
-                True,
-                "false with share = 'maps' (a map rebuilt after a loop closure would be sent "
-                "again on top of what the neighbours hold; share 'scans' instead)",
-            )
+        yield from choice_problems(self, "share")
 
     def adapters(self) -> tuple[str, ...]:
         """The adapters these settings ask for: the robots' mapping when enabled."""

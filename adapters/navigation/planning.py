@@ -17,9 +17,9 @@ import time
 
 import numpy as np
 
+from adapters.fleet.robots_layer import RobotsLayer
 from adapters.navigation.contract import GlobalPlanner, PlanRequest, RepairRequest
 from adapters.navigation.layers import StaticLayers, open_goal
-from adapters.navigation.robots_layer import RobotsLayer
 from adapters.navigation.scan_memory import MovingMemory, ScanMemory
 from adapters.navigation.tables import NavRecords
 from cosim.core.adapter import RunContext

@@ -25,6 +25,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from adapters.fleet.motion import drive_limits
+from adapters.fleet.robots_layer import RobotsLayer
 from adapters.mapping.settings import MappingConfig
 from adapters.naming import topic
 from adapters.navigation.contract import (
@@ -42,7 +43,6 @@ from adapters.navigation.layers import StaticLayers, padded, robot_layers, stati
 from adapters.navigation.localization import Localization
 from adapters.navigation.planning import GlobalPlanning
 from adapters.navigation.recovery import Recovery, StallWatch
-from adapters.navigation.robots_layer import RobotsLayer
 from adapters.navigation.scan_memory import MovingMemory, ScanMemory
 from adapters.navigation.settings import NavigationConfig
 from adapters.navigation.tables import NAVIGATION, NavRecords
@@ -147,6 +147,7 @@ class NavigationAdapter:
             self.robots_layer = RobotsLayer(
                 self.names, self.hosts, radius, cfg.robots_layer_timeout_s
             )
+            run.provide(self.robots_layer)
         self.records = NavRecords(run.recorder, self.names)
         self.rngs = [run.rng.stream(f"navigation/{name}") for name in self.names]
         self.traffic = TrafficParams()

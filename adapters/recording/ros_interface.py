@@ -31,11 +31,11 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from adapters.assignment.topics import TASKS
 from adapters.fleet.motion import FleetAdapter
 from adapters.humans.people import People
 from adapters.naming import topic
 from adapters.recording.poses import PosesAdapter
+from adapters.tasks.topics import TASKS
 from cosim.core.adapter import RunContext
 from cosim.core.bus import TopicQos
 from cosim.core.hosts import BASE_HOST

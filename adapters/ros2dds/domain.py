@@ -45,9 +45,7 @@ PROBED_INDICES = 10
 
 @runtime_checkable
 class DomainSettings(Protocol):
-    """Settings naming a run's DDS domain: ``physical.dds_domain`` and ``physical.interface``.
-
-    """
+    """Settings naming a run's DDS domain (the physical section's ``dds_domain``, ``interface``)."""
 
     @property
     def dds_domain(self) -> int | Literal["auto"]:

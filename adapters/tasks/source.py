@@ -5,8 +5,9 @@ whenever one is completed (as in the paper), up to ``tasks.max_total``. The open
 are broadcast as a :class:`~cosim.core.messages.TaskSet` over the network whenever they change
 (a new *epoch*) and every ``assignment.rebroadcast_s``. It keeps the book of claims and is
 the one authority on service: a robot at a task asks for the right to serve it, and only
-one robot ever gets it (see :mod:`models.tasks.book`). With a central protocol (one whose
-``central`` is true, such as ``hungarian``) it also asks the protocol, at every
+one robot ever gets it (see :mod:`models.tasks.book`). How claims are kept is the
+assignment's to say (:mod:`adapters.tasks.contract`); with a central solver (a protocol
+whose ``central`` is true, such as ``hungarian``) it also asks the solver, at every
 announcement, for the free robots' tasks from their reported poses and sends each robot its
 order over the network.
 """
@@ -19,13 +20,9 @@ from typing import Any, ClassVar
 import numpy as np
 from scipy import ndimage
 
-from adapters.assignment.contract import (
-    AssignmentProtocolType,
-    ProtocolInUse,
-    protocol_registry,
-)
-from adapters.assignment.settings import AssignmentConfig
-from adapters.assignment.topics import (
+from adapters.tasks.contract import CentralOrders, CentralSolver, claim_rules
+from adapters.tasks.settings import TasksConfig
+from adapters.tasks.topics import (
     CLAIMS,
     DONE,
     REPORTS,
@@ -35,7 +32,6 @@ from adapters.assignment.topics import (
     order_topic,
     reply_topic,
 )
-from adapters.tasks.settings import TasksConfig
 from cosim.core.adapter import RunContext
 from cosim.core.bus import Envelope
 from cosim.core.errors import ScenarioError
@@ -92,7 +88,7 @@ class TaskSourceAdapter:
 
     def __init__(self, run: RunContext) -> None:
         self.cfg = run.settings(TasksConfig)
-        self.assignment = run.settings(AssignmentConfig)
+        self.rules = claim_rules(run.scenario.sections)
         world = run.service(Warehouse)
         fleet = run.service(FleetState)
         self.robots = list(fleet.names)
@@ -105,17 +101,17 @@ class TaskSourceAdapter:
                 "a shelf face) is free and reachable by the fleet; expected shelves with "
                 "room in front of them (tasks are served at shelves)"
             )
-        self.central = protocol_registry().get(self.assignment.protocol).central
+        self.central = self.rules.central
         self.rng = run.rng.stream("tasks")
         self.book = TaskBook(
-            self.robots, s_to_ns(self.assignment.claim_timeout_s), self.assignment.preemption
+            self.robots, s_to_ns(self.rules.claim_timeout_s), self.rules.preemption
         )
         self.next_id = 0
         self.epoch = 0
         self.dirty = True
         self.last_announce_ns = -(1 << 62)
         self.poses: dict[str, tuple[float, float]] = {}
-        self.protocol: AssignmentProtocolType | None = None
+        self.solver: CentralSolver | None = None
         self.orders: dict[str, tuple[int, float]] = {}
         run.provide(self)
         run.bus.advertise(TASKS, TaskSet)
@@ -132,7 +128,7 @@ class TaskSourceAdapter:
         bus.subscribe(CLAIMS, BASE_HOST, self._handler(run, self._on_claim))
         bus.subscribe(SERVICE_REQUESTS, BASE_HOST, self._handler(run, self._on_request))
         bus.subscribe(DONE, BASE_HOST, self._handler(run, self._on_done))
-        self.protocol = run.service(ProtocolInUse).protocol if self.central else None
+        self.solver = run.service(CentralOrders).solver if self.central else None
         if self.central:
             bus.subscribe(REPORTS, BASE_HOST, self._handler(run, self._on_report))
         for _ in range(self.cfg.initial):
@@ -180,15 +176,15 @@ class TaskSourceAdapter:
                 return chosen
 
     def _announce(self, run: RunContext, now_ns: int) -> None:
-        due = now_ns - self.last_announce_ns >= s_to_ns(self.assignment.rebroadcast_s)
+        due = now_ns - self.last_announce_ns >= s_to_ns(self.rules.rebroadcast_s)
         if not (self.dirty or due):
             return
         if self.dirty:
             self.epoch += 1
             self.dirty = False
-        if self.protocol is not None:
+        if self.solver is not None:
             # re-solved at every announcement: robot poses arrive over time
-            self._solve_centrally(self.protocol)
+            self._solve_centrally(self.solver)
         self.last_announce_ns = now_ns
         tasks = tuple(
             TaskInfo(
@@ -246,9 +242,9 @@ class TaskSourceAdapter:
     def _on_report(self, run: RunContext, state: RobotState) -> None:
         self.poses[state.robot] = (state.x_m, state.y_m)
 
-    # -- a central protocol ------------------------------------------------------------------
-    def _solve_centrally(self, protocol: AssignmentProtocolType) -> None:
-        """The protocol's orders for the robots whose pose the base knows and are free."""
+    # -- a central solver ------------------------------------------------------------------
+    def _solve_centrally(self, solver: CentralSolver) -> None:
+        """The solver's orders for the robots whose pose the base knows and are free."""
         held = {t.task_id: self.book.holder(t) for t in self.book.offered()}
         tasks = [
             TaskInfo(t.task_id, t.x_m, t.y_m, tuple(sorted(t.eligible, key=self.robots.index)), "")
@@ -258,7 +254,7 @@ class TaskSourceAdapter:
         busy = {holder for holder in held.values() if holder}
         poses = {r: self.poses[r] for r in self.robots if r in self.poses and r not in busy}
         self.orders = {r: order for r, order in self.orders.items() if r in busy}
-        self.orders.update(protocol.orders(tasks, poses))
+        self.orders.update(solver.orders(tasks, poses))
 
     # -- records ---------------------------------------------------------------------------
     def finish(self, run: RunContext) -> Mapping[str, Any]:

@@ -3,7 +3,9 @@
 With ``navigation.robots_layer`` each robot publishes a :class:`~cosim.core.messages.RobotState`
 on ``/fleet/robot_states`` at ``robots_layer_hz`` (latency and loss apply), and each keeps
 what it last heard from the others; a robot not heard from for ``robots_layer_timeout_s``
-is forgotten. The global planner and the local controller avoid the discs it knows.
+is forgotten. The navigation builds it and offers it as a service of the run: the global
+planner and the local controller avoid the discs it knows, and the robots' mapping leaves
+returns off them out of their maps.
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from adapters.fleet.topics import ROBOT_STATES
 from cosim.core.adapter import RunContext
 from cosim.core.bus import Envelope
 from cosim.core.hosts import HostId
@@ -19,8 +22,6 @@ from cosim.core.kernel import Stage
 from cosim.core.messages import Message, RobotState
 from cosim.core.timebase import period_ns, s_to_ns
 from models.arrays import FloatArray, IntArray
-
-ROBOT_STATES = "/fleet/robot_states"
 
 
 class RobotsLayer:
