@@ -159,6 +159,11 @@ def protocol_contract(name: str, loaded: Any) -> str | None:
         return f"message = {message!r} and topic = {topic!r}: expected both or neither"
     if message is not None and not (isinstance(message, type) and issubclass(message, Message)):
         return f"message = {message!r}: expected a cosim.core.messages.Message subclass"
+    if message is not None and not hasattr(message, "wire"):
+        return (
+            f"message = {message.__name__}: expected a message declared with "
+            "cosim.core.messages.ros_message (its wire type, size and encoding come from it)"
+        )
     for flag in ("central", "compare_to_optimum"):
         if not isinstance(getattr(loaded, flag, None), bool):
             return f"{flag} = {getattr(loaded, flag, None)!r}: expected True or False"

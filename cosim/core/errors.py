@@ -54,3 +54,10 @@ class BridgeError(CosimError):
 
     Raised while the kernel runs, it ends the run keeping what ran (:attr:`kept`).
     """
+
+
+class WireError(CosimError):
+    """Bytes are not the message they are said to be (CDR too short, a bad string, ...).
+
+    Also raised when a message type is declared wrongly (a field without a wire type).
+    """

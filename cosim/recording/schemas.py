@@ -3,8 +3,9 @@
 A channel of a recording is a topic with its ROS 2 type, the type's ``.msg`` definition
 with every nested definition appended as rosbag2 embeds it (``ros2msg``), the type's
 RIHS01 hash, and the QoS the topic is offered with. Standard types come from rosbags'
-ROS 2 Humble type store; the project's own (``cosim_msgs``) from
-:mod:`cosim.core.messages.definitions`, so any tool decodes every recorded message.
+ROS 2 Humble type store; the project's own (``cosim_msgs``) and a plugin's from their
+declarations (each message class's ``wire`` type and the types it nests), so any tool
+decodes every recorded message.
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
 
 from cosim.core.bus import Advertisement, TopicQos
-from cosim.core.messages.definitions import DEFINITIONS
+from cosim.core.messages.wire import Struct
 
 INFINITE = QosTime(2_147_483_647, 4_294_967_295)
 """An unset deadline, lifespan or lease as Humble's rosbag2 writes it (v8 metadata)."""
@@ -52,13 +53,20 @@ class ChannelSpec:
 
 @lru_cache(maxsize=1)
 def typestore() -> Typestore:
-    """ROS 2 Humble's standard types plus ``cosim_msgs`` (built once per process)."""
-    store = get_typestore(Stores.ROS2_HUMBLE)
-    types = {}
-    for name, text in DEFINITIONS.items():
-        types.update(get_types_from_msg(text, name))
-    store.register(types)
-    return store
+    """ROS 2 Humble's standard types (built once per process; declared types join it)."""
+    return get_typestore(Stores.ROS2_HUMBLE)
+
+
+def register(kind: Struct) -> None:
+    """Make a declared type, and every type it nests, known to the type store.
+
+    Standard types are there already; a type of cosim's or a plugin's is registered from
+    its ``.msg`` text.
+    """
+    store = typestore()
+    for nested in [*kind.dependencies(), kind]:
+        if nested.ros_type not in store.fielddefs:
+            store.register(get_types_from_msg(nested.msg_text(), nested.ros_type))
 
 
 @lru_cache(maxsize=256)
@@ -70,26 +78,14 @@ def definition(msgtype: str) -> tuple[str, str]:
 
 
 def channel_specs(topics: Mapping[str, Advertisement]) -> list[ChannelSpec]:
-    """The channels of the given advertised topics, in their order.
-
-    A plugin's own message type (one neither in ROS 2 Humble nor in ``cosim_msgs``) is
-    known by the ``.msg`` text its class declares as ``ros_definition``.
-    """
+    """The channels of the given advertised topics, in their order."""
     specs = []
     for topic, ad in topics.items():
         msgtype = ad.message_type.ros_type
-        _register(msgtype, getattr(ad.message_type, "ros_definition", None))
+        register(ad.message_type.wire)
         text, digest = definition(msgtype)
         specs.append(ChannelSpec(topic, msgtype, text, digest, ad.qos))
     return specs
-
-
-def _register(msgtype: str, text: str | None) -> None:
-    """Make a plugin's own message type known to the type store, from its ``.msg`` text."""
-    store = typestore()
-    if text is None or msgtype in store.fielddefs:
-        return
-    store.register(get_types_from_msg(text, msgtype))
 
 
 def recorded_qos(qos: TopicQos) -> list[Qos]:

@@ -1,32 +1,26 @@
 """Assignment-protocol messages (``cosim_msgs``): rounds, central orders and decisions.
 
-Sizes are those of the CDR encoding of the documented field layout.
+Every header is in ``map``.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from functools import lru_cache
-from typing import ClassVar
+from typing import Annotated
 
-from cosim.core.messages.base import Message
-from cosim.core.messages.cdr import ENCAPSULATION, doubles, header, string, uint32
-from cosim.core.messages.encoder import CdrWriter
+from cosim.core.messages.aliases import Float64s, Header, Int32s, float64, int32, string, uint32
+from cosim.core.messages.declare import Message, ros_message
+from cosim.core.messages.wire import FLOAT64, INT32, UINT8, Sequence, struct
 
 Column = tuple[int, int, int, float]
 """A column of the assignment LP: (kind, robot index, task index, cost)."""
 
-
-@lru_cache(maxsize=1024)
-def _columns_end(offset: int, count: int) -> int:
-    # per column: uint8 kind, int32 robot, int32 task, float64 cost
-    offset = uint32(offset)
-    for _ in range(count):
-        offset = doubles(uint32(uint32(offset + 1)), 1)
-    return offset
+SIMPLEX_COLUMN = struct(
+    "cosim_msgs/msg/SimplexColumn", kind=UINT8, robot=INT32, task=INT32, cost=FLOAT64
+)
+"""A basis column on the wire (a :data:`Column` tuple in the message)."""
 
 
-@dataclass(frozen=True, slots=True)
+@ros_message("cosim_msgs/msg/SimplexBasis")
 class SimplexBasis(Message):
     """A robot's current basis in a distributed-simplex round (``cosim_msgs/msg/SimplexBasis``).
 
@@ -38,35 +32,14 @@ class SimplexBasis(Message):
         columns: the basis columns (kind, robot index, task index, cost).
     """
 
-    ros_type: ClassVar[str] = "cosim_msgs/msg/SimplexBasis"
-    stamp_ns: int
-    epoch: int
-    robot: str
-    round: int
-    columns: tuple[Column, ...]
-
-    def size_bytes(self) -> int:
-        """Header, uint32 epoch, robot name, uint32 round, sequence of columns."""
-        offset = uint32(string(uint32(header(0, "map")), self.robot))
-        return ENCAPSULATION + _columns_end(offset, len(self.columns))
-
-    def to_cdr(self) -> bytes:
-        """Header in ``map``, epoch, robot, round, the columns."""
-        w = CdrWriter()
-        w.header(self.stamp_ns, "map")
-        w.u32(self.epoch)
-        w.string(self.robot)
-        w.u32(self.round)
-        w.u32(len(self.columns))
-        for kind, robot, task, cost in self.columns:
-            w.u8(kind)
-            w.i32(robot)
-            w.i32(task)
-            w.f64(cost)
-        return w.data()
+    stamp_ns: Header
+    epoch: uint32
+    robot: string
+    round: uint32
+    columns: Annotated[tuple[Column, ...], Sequence(SIMPLEX_COLUMN)]
 
 
-@dataclass(frozen=True, slots=True)
+@ros_message("cosim_msgs/msg/AuctionBids")
 class AuctionBids(Message):
     """A robot's view of the winning bids (CBBA consensus; ``cosim_msgs/msg/AuctionBids``).
 
@@ -78,31 +51,14 @@ class AuctionBids(Message):
         winners: winning robot index known per task index (-1: none).
     """
 
-    ros_type: ClassVar[str] = "cosim_msgs/msg/AuctionBids"
-    stamp_ns: int
-    epoch: int
-    robot: str
-    bids: tuple[float, ...]
-    winners: tuple[int, ...]
-
-    def size_bytes(self) -> int:
-        """Header, uint32 epoch, robot name, float64 sequence, int32 sequence."""
-        offset = string(uint32(header(0, "map")), self.robot)
-        offset = doubles(uint32(offset), len(self.bids))
-        return ENCAPSULATION + uint32(offset) + 4 * len(self.winners)
-
-    def to_cdr(self) -> bytes:
-        """Header in ``map``, epoch, robot, bids, winners."""
-        w = CdrWriter()
-        w.header(self.stamp_ns, "map")
-        w.u32(self.epoch)
-        w.string(self.robot)
-        w.f64_seq(self.bids)
-        w.i32_seq(self.winners)
-        return w.data()
+    stamp_ns: Header
+    epoch: uint32
+    robot: string
+    bids: Float64s
+    winners: Int32s
 
 
-@dataclass(frozen=True, slots=True)
+@ros_message("cosim_msgs/msg/TaskOrder")
 class TaskOrder(Message):
     """The base station tells a robot its task (centralized baseline; ``cosim_msgs/msg/TaskOrder``).
 
@@ -114,30 +70,14 @@ class TaskOrder(Message):
         cost_m: the robot's cost for it (m).
     """
 
-    ros_type: ClassVar[str] = "cosim_msgs/msg/TaskOrder"
-    stamp_ns: int
-    epoch: int
-    robot: str
-    task_id: int
-    cost_m: float
-
-    def size_bytes(self) -> int:
-        """Header, uint32 epoch, robot name, int32, float64."""
-        offset = uint32(string(uint32(header(0, "map")), self.robot))
-        return ENCAPSULATION + doubles(offset, 1)
-
-    def to_cdr(self) -> bytes:
-        """Header in ``map``, epoch, robot, task id, cost."""
-        w = CdrWriter()
-        w.header(self.stamp_ns, "map")
-        w.u32(self.epoch)
-        w.string(self.robot)
-        w.i32(self.task_id)
-        w.f64(self.cost_m)
-        return w.data()
+    stamp_ns: Header
+    epoch: uint32
+    robot: string
+    task_id: int32
+    cost_m: float64
 
 
-@dataclass(frozen=True, slots=True)
+@ros_message("cosim_msgs/msg/TaskAssignment")
 class TaskAssignment(Message):
     """What a robot's assignment protocol decided in an epoch (``cosim_msgs/msg/TaskAssignment``).
 
@@ -153,29 +93,19 @@ class TaskAssignment(Message):
         rounds: protocol rounds the robot ran in the epoch before deciding.
     """
 
-    ros_type: ClassVar[str] = "cosim_msgs/msg/TaskAssignment"
-    stamp_ns: int
-    epoch: int
-    robot: str
-    task_id: int
-    cost_m: float
-    rounds: int
-
-    def size_bytes(self) -> int:
-        """Header, uint32 epoch, robot name, int32 task, float64 cost, uint32 rounds."""
-        offset = uint32(string(uint32(header(0, "map")), self.robot))
-        return ENCAPSULATION + uint32(doubles(offset, 1))
-
-    def to_cdr(self) -> bytes:
-        """Header in ``map``, epoch, robot, task id, cost, rounds."""
-        w = CdrWriter()
-        w.header(self.stamp_ns, "map")
-        w.u32(self.epoch)
-        w.string(self.robot)
-        w.i32(self.task_id)
-        w.f64(self.cost_m)
-        w.u32(self.rounds)
-        return w.data()
+    stamp_ns: Header
+    epoch: uint32
+    robot: string
+    task_id: int32
+    cost_m: float64
+    rounds: uint32
 
 
-__all__ = ["AuctionBids", "Column", "SimplexBasis", "TaskAssignment", "TaskOrder"]
+__all__ = [
+    "SIMPLEX_COLUMN",
+    "AuctionBids",
+    "Column",
+    "SimplexBasis",
+    "TaskAssignment",
+    "TaskOrder",
+]

@@ -1,19 +1,26 @@
-"""What robots share to map together (``cosim_msgs``): localized scans and map updates."""
+"""What robots share to map together (``cosim_msgs``): localized scans and map updates.
+
+Every header is in ``map``.
+"""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import ClassVar
+from dataclasses import field
 
-import numpy as np
-import numpy.typing as npt
+from cosim.core.messages.aliases import (
+    Bytes,
+    Float32s,
+    Header,
+    float32,
+    float64,
+    int32,
+    string,
+    uint32,
+)
+from cosim.core.messages.declare import Message, ros_message
 
-from cosim.core.messages.base import Message
-from cosim.core.messages.cdr import ENCAPSULATION, doubles, float_seq, header, string, uint32
-from cosim.core.messages.encoder import CdrWriter
 
-
-@dataclass(frozen=True, slots=True)
+@ros_message("cosim_msgs/msg/LocalizedScan")
 class LocalizedScan(Message):
     """A scan with the pose its robot estimated for it (``cosim_msgs/msg/LocalizedScan``).
 
@@ -29,39 +36,22 @@ class LocalizedScan(Message):
         ranges_m: float32 ranges (REP 117), read-only.
     """
 
-    ros_type: ClassVar[str] = "cosim_msgs/msg/LocalizedScan"
-    stamp_ns: int
-    robot: str
-    x_m: float
-    y_m: float
-    yaw_rad: float
-    angle_min_rad: float
-    angle_increment_rad: float
-    range_min_m: float
-    range_max_m: float
-    ranges_m: npt.NDArray[np.float32] = field(repr=False)
+    stamp_ns: Header
+    robot: string
+    x_m: float64
+    y_m: float64
+    yaw_rad: float64
+    angle_min_rad: float32
+    angle_increment_rad: float32
+    range_min_m: float32
+    range_max_m: float32
+    ranges_m: Float32s = field(repr=False)
 
     def __post_init__(self) -> None:
         self.ranges_m.flags.writeable = False
 
-    def size_bytes(self) -> int:
-        """Header, robot, three float64, four float32, float32 ranges."""
-        offset = doubles(string(header(0, "map"), self.robot), 3)
-        offset = float_seq(uint32(uint32(uint32(offset))) + 4, len(self.ranges_m))
-        return ENCAPSULATION + offset
 
-    def to_cdr(self) -> bytes:
-        """Header in ``map``, robot, pose, beam geometry, ranges."""
-        w = CdrWriter()
-        w.header(self.stamp_ns, "map")
-        w.string(self.robot)
-        w.f64s((self.x_m, self.y_m, self.yaw_rad))
-        w.f32s((self.angle_min_rad, self.angle_increment_rad, self.range_min_m, self.range_max_m))
-        w.f32_seq(self.ranges_m)
-        return w.data()
-
-
-@dataclass(frozen=True, slots=True)
+@ros_message("cosim_msgs/msg/MapUpdate")
 class MapUpdate(Message):
     """A block of a robot's new map evidence (``cosim_msgs/msg/MapUpdate``).
 
@@ -76,38 +66,17 @@ class MapUpdate(Message):
         ix0, iy0: the rectangle's lower-left cell in the common map grid.
         width, height: its size in cells.
         scale: log-odds per int8 step.
+        encoding: how ``data`` is packed.
         data: the compressed cells.
     """
 
-    ros_type: ClassVar[str] = "cosim_msgs/msg/MapUpdate"
-    stamp_ns: int
-    robot: str
-    seq: int
-    ix0: int
-    iy0: int
-    width: int
-    height: int
-    scale: float
-    data: bytes = field(repr=False)
-
-    def size_bytes(self) -> int:
-        """Header, robot, five uint32/int32, float32, encoding string, byte sequence."""
-        offset = uint32(string(header(0, "map"), self.robot))
-        offset = uint32(uint32(uint32(uint32(uint32(offset)))))
-        offset = string(offset, "zlib-int8")
-        return ENCAPSULATION + uint32(offset) + len(self.data)
-
-    def to_cdr(self) -> bytes:
-        """Header in ``map``, robot, rectangle, scale, encoding, data."""
-        w = CdrWriter()
-        w.header(self.stamp_ns, "map")
-        w.string(self.robot)
-        w.u32(self.seq)
-        w.i32(self.ix0)
-        w.i32(self.iy0)
-        w.u32(self.width)
-        w.u32(self.height)
-        w.f32(self.scale)
-        w.string("zlib-int8")
-        w.u8_seq(self.data)
-        return w.data()
+    stamp_ns: Header
+    robot: string
+    seq: uint32
+    ix0: int32
+    iy0: int32
+    width: uint32
+    height: uint32
+    scale: float32
+    encoding: string = field(default="zlib-int8", kw_only=True)
+    data: Bytes = field(repr=False)

@@ -1,52 +1,35 @@
-"""The project's own messages (``cosim_msgs``): navigation goals and fleet coordination."""
+"""The project's own navigation messages (``cosim_msgs``): goals, their progress, robot states."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import ClassVar
-
-from cosim.core.messages.base import Message
-from cosim.core.messages.cdr import ENCAPSULATION, doubles, header, string, uint32
-from cosim.core.messages.encoder import CdrWriter
+from cosim.core.messages.aliases import Header, float64, string, uint32
+from cosim.core.messages.declare import Message, ros_message
 
 
-@dataclass(frozen=True, slots=True)
+@ros_message("cosim_msgs/msg/NavGoal")
 class NavGoal(Message):
     """A "go to (x, y[, yaw])" goal for a robot's navigation (``cosim_msgs/msg/NavGoal``).
 
     Attributes:
-        stamp_ns: when the goal was issued, ns.
+        stamp_ns: when the goal was issued, ns (header in ``map``).
         goal_id: the sender's id of this goal; statuses refer to it.
         x_m, y_m: goal position in ``map`` (m).
         yaw_rad: goal heading in ``map`` (rad), or ``nan`` for any heading.
     """
 
-    ros_type: ClassVar[str] = "cosim_msgs/msg/NavGoal"
-    stamp_ns: int
-    goal_id: int
-    x_m: float
-    y_m: float
-    yaw_rad: float = float("nan")
-
-    def size_bytes(self) -> int:
-        """Header in ``map``, uint32 id, three float64."""
-        return ENCAPSULATION + doubles(uint32(header(0, "map")), 3)
-
-    def to_cdr(self) -> bytes:
-        """Header in ``map``, goal id, x, y, yaw."""
-        w = CdrWriter()
-        w.header(self.stamp_ns, "map")
-        w.u32(self.goal_id)
-        w.f64s((self.x_m, self.y_m, self.yaw_rad))
-        return w.data()
+    stamp_ns: Header
+    goal_id: uint32
+    x_m: float64
+    y_m: float64
+    yaw_rad: float64 = float("nan")
 
 
-@dataclass(frozen=True, slots=True)
+@ros_message("cosim_msgs/msg/NavStatus")
 class NavStatus(Message):
     """Progress of a navigation goal (``cosim_msgs/msg/NavStatus``).
 
     Attributes:
-        stamp_ns: time of the report, ns.
+        stamp_ns: time of the report, ns (header in ``map``).
         goal_id: the goal it is about.
         state: ``accepted`` | ``progress`` | ``arrived`` | ``stuck`` | ``unreachable`` |
             ``cancelled``.
@@ -54,60 +37,32 @@ class NavStatus(Message):
         remaining_m: path length still to go (m), ``nan`` when unknown.
     """
 
-    ros_type: ClassVar[str] = "cosim_msgs/msg/NavStatus"
-    stamp_ns: int
-    goal_id: int
-    state: str
-    x_m: float
-    y_m: float
-    remaining_m: float
-
-    def size_bytes(self) -> int:
-        """Header, uint32 id, state string, three float64."""
-        offset = string(uint32(header(0, "map")), self.state)
-        return ENCAPSULATION + doubles(offset, 3)
-
-    def to_cdr(self) -> bytes:
-        """Header in ``map``, goal id, state, x, y, remaining."""
-        w = CdrWriter()
-        w.header(self.stamp_ns, "map")
-        w.u32(self.goal_id)
-        w.string(self.state)
-        w.f64s((self.x_m, self.y_m, self.remaining_m))
-        return w.data()
+    stamp_ns: Header
+    goal_id: uint32
+    state: string
+    x_m: float64
+    y_m: float64
+    remaining_m: float64
 
 
-@dataclass(frozen=True, slots=True)
+@ros_message("cosim_msgs/msg/RobotState")
 class RobotState(Message):
     """A robot's pose, speed and footprint, broadcast to the others (robots layer).
 
     ``cosim_msgs/msg/RobotState``, as a Nav2 user's shared "robots layer" would send.
 
     Attributes:
-        stamp_ns: time of the pose, ns.
+        stamp_ns: time of the pose, ns (header in ``map``).
         robot: the robot's name.
         x_m, y_m, yaw_rad: pose in ``map`` (m, m, rad).
         v_mps: forward speed (m/s).
         radius_m: footprint radius (m).
     """
 
-    ros_type: ClassVar[str] = "cosim_msgs/msg/RobotState"
-    stamp_ns: int
-    robot: str
-    x_m: float
-    y_m: float
-    yaw_rad: float
-    v_mps: float
-    radius_m: float
-
-    def size_bytes(self) -> int:
-        """Header, robot name, five float64."""
-        return ENCAPSULATION + doubles(string(header(0, "map"), self.robot), 5)
-
-    def to_cdr(self) -> bytes:
-        """Header in ``map``, robot name, x, y, yaw, v, radius."""
-        w = CdrWriter()
-        w.header(self.stamp_ns, "map")
-        w.string(self.robot)
-        w.f64s((self.x_m, self.y_m, self.yaw_rad, self.v_mps, self.radius_m))
-        return w.data()
+    stamp_ns: Header
+    robot: string
+    x_m: float64
+    y_m: float64
+    yaw_rad: float64
+    v_mps: float64
+    radius_m: float64

@@ -7,19 +7,34 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from enum import IntEnum
-from typing import ClassVar
 
-from cosim.core.messages.base import Message
-from cosim.core.messages.cdr import ENCAPSULATION, align, doubles, header, string, uint32
-from cosim.core.messages.encoder import CdrWriter
+from cosim.core.messages import std
+from cosim.core.messages.declare import Message, ros_message
+from cosim.core.messages.views import Const, Each, Outer, Planar
 
 RGBA = tuple[float, float, float, float]
 """A colour: red, green, blue, alpha in [0, 1]."""
 
 
-@dataclass(frozen=True, slots=True)
+@ros_message(
+    std.OCCUPANCY_GRID,
+    wire={
+        "header.stamp": "stamp_ns",
+        "header.frame_id": "frame_id",
+        "info.map_load_time": "stamp_ns",
+        "info.resolution": "resolution_m",
+        "info.width": "width",
+        "info.height": "height",
+        "info.origin.position.x": "origin_x_m",
+        "info.origin.position.y": "origin_y_m",
+        "info.origin.orientation.w": Const(1.0),
+        "data": "data",
+    },
+)
 class OccupancyGrid(Message):
     """A 2D occupancy map (``nav_msgs/msg/OccupancyGrid``), as map_server publishes on ``/map``.
+
+    Its metadata's load time is its stamp; the origin has no rotation.
 
     Attributes:
         stamp_ns: time of the map, ns.
@@ -31,7 +46,6 @@ class OccupancyGrid(Message):
             100 occupied, -1 unknown).
     """
 
-    ros_type: ClassVar[str] = "nav_msgs/msg/OccupancyGrid"
     stamp_ns: int
     frame_id: str
     resolution_m: float
@@ -46,24 +60,6 @@ class OccupancyGrid(Message):
             raise ValueError(
                 f"occupancy grid of {self.width} x {self.height} cells got {len(self.data)} values"
             )
-
-    def size_bytes(self) -> int:
-        """Header, MapMetaData (time, float32, two uint32, Pose), int8 sequence."""
-        offset = header(0, self.frame_id)
-        offset = doubles(uint32(uint32(uint32(align(offset, 4) + 8))), 7)
-        return ENCAPSULATION + uint32(offset) + len(self.data)
-
-    def to_cdr(self) -> bytes:
-        """Header, metadata (load time = stamp), cells."""
-        w = CdrWriter()
-        w.header(self.stamp_ns, self.frame_id)
-        w.time(self.stamp_ns)
-        w.f32(self.resolution_m)
-        w.u32(self.width)
-        w.u32(self.height)
-        w.pose2d(self.origin_x_m, self.origin_y_m, 0.0)
-        w.u8_seq(self.data)
-        return w.data()
 
 
 class MarkerType(IntEnum):
@@ -113,70 +109,39 @@ class Marker:
     frame_locked: bool = False
     text: str = ""
 
-    def end(self, offset: int) -> int:
-        """CDR offset after this marker (Humble/Jazzy layout, empty optional fields)."""
-        offset = string(header(offset, self.frame_id), self.ns)
-        offset = uint32(uint32(uint32(offset)))  # id, type, action
-        offset = doubles(offset, 7 + 3)  # pose, scale
-        offset = uint32(uint32(align(offset, 4) + 16))  # color, lifetime (int32, uint32)
-        offset = uint32(uint32(offset + 1))  # frame_locked, empty points, empty colors
-        offset = string(offset, "")  # texture_resource
-        offset = uint32(string(header(offset, ""), ""))  # texture: header, format, data
-        offset = uint32(offset)  # uv_coordinates
-        offset = string(string(offset, self.text), "")  # text, mesh_resource
-        offset = uint32(string(offset, ""))  # mesh_file: filename, data
-        return offset + 1  # mesh_use_embedded_materials
 
-    def write(self, w: CdrWriter, stamp_ns: int) -> None:
-        """Append this marker to a message being encoded."""
-        w.header(stamp_ns, self.frame_id)
-        w.string(self.ns)
-        w.i32(self.marker_id)
-        w.i32(int(self.kind))
-        w.i32(int(self.action))
-        w.pose2d(self.x_m, self.y_m, self.yaw_rad, self.z_m)
-        w.f64s(self.scale_m)
-        w.f32s(self.color)
-        w.time(0)  # lifetime 0: forever
-        w.boolean(self.frame_locked)
-        w.u32(0)  # points
-        w.u32(0)  # colors
-        w.string("")  # texture_resource
-        w.header(0, "")  # texture (sensor_msgs/CompressedImage), empty
-        w.string("")
-        w.u32(0)
-        w.u32(0)  # uv_coordinates
-        w.string(self.text)
-        w.string("")  # mesh_resource
-        w.string("")  # mesh_file.filename
-        w.u32(0)  # mesh_file.data
-        w.boolean(False)  # mesh_use_embedded_materials
-
-
-@dataclass(frozen=True, slots=True)
+@ros_message(
+    std.MARKER_ARRAY,
+    wire={
+        "markers": Each(
+            "markers",
+            Marker,
+            {
+                "header.stamp": Outer("stamp_ns"),
+                "header.frame_id": "frame_id",
+                "ns": "ns",
+                "id": "marker_id",
+                "type": "kind",
+                "action": "action",
+                "pose": Planar("x_m", "y_m", "yaw_rad", z="z_m"),
+                "scale": "scale_m",
+                "color": "color",
+                "frame_locked": "frame_locked",
+                "text": "text",
+            },
+        )
+    },
+)
 class MarkerArray(Message):
     """Shapes for RViz and Foxglove (``visualization_msgs/msg/MarkerArray``).
+
+    Every marker carries the array's stamp; lifetime 0 (forever); no points, colours,
+    texture or mesh.
 
     Attributes:
         stamp_ns: time of every marker, ns.
         markers: the markers, applied in order.
     """
 
-    ros_type: ClassVar[str] = "visualization_msgs/msg/MarkerArray"
     stamp_ns: int
     markers: tuple[Marker, ...]
-
-    def size_bytes(self) -> int:
-        """A sequence of Marker."""
-        offset = uint32(0)
-        for marker in self.markers:
-            offset = marker.end(offset)
-        return ENCAPSULATION + offset
-
-    def to_cdr(self) -> bytes:
-        """Every marker with the array's stamp."""
-        w = CdrWriter()
-        w.u32(len(self.markers))
-        for marker in self.markers:
-            marker.write(w, self.stamp_ns)
-        return w.data()

@@ -11,26 +11,15 @@ Multi-Robot Routing", Robotics: Science and Systems 2005), here with one task pe
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from functools import lru_cache
-from typing import Any, ClassVar, Literal
+from dataclasses import dataclass
+from typing import ClassVar, Literal
 
 import numpy as np
-from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 from adapters.assignment.contract import EpochView, ProtocolAgent, ProtocolBase, ProtocolFleet
-from cosim.core.messages import Message
+from cosim.core.messages import Float64s, Message, Time, ros_message, string, uint32
 from cosim.scenario.fields import param
 from models.arrays import FloatArray
-
-BID_TABLE = "labkit_msgs/msg/BidTable"
-BID_TABLE_MSG = """builtin_interfaces/Time stamp
-uint32 epoch
-string robot
-uint32 robots
-uint32 tasks
-float64[] costs
-"""
 
 
 @dataclass(frozen=True)
@@ -45,48 +34,16 @@ class AuctionSettings:
     )
 
 
-@lru_cache(maxsize=1)
-def _store() -> Any:
-    store = get_typestore(Stores.ROS2_HUMBLE)
-    store.register(get_types_from_msg(BID_TABLE_MSG, BID_TABLE))
-    return store
-
-
-@dataclass(frozen=True)
+@ros_message("labkit_msgs/msg/BidTable")
 class BidTable(Message):
     """The bids a robot knows: costs (m) of robots (rows) for tasks (columns), inf unknown."""
 
-    ros_type: ClassVar[str] = BID_TABLE
-    ros_definition: ClassVar[str | None] = BID_TABLE_MSG
-    stamp_ns: int
-    epoch: int
-    robot: str
-    robots: int
-    tasks: int
-    costs: tuple[float, ...]
-    _cdr: list[bytes] = field(default_factory=list, repr=False, compare=False)
-
-    def to_cdr(self) -> bytes:
-        """The table as ROS 2 serializes it (rosbags' CDR serializer), made once."""
-        if not self._cdr:
-            store = _store()
-            stamp = store.types["builtin_interfaces/msg/Time"](
-                sec=self.stamp_ns // 1_000_000_000, nanosec=self.stamp_ns % 1_000_000_000
-            )
-            message = store.types[BID_TABLE](
-                stamp=stamp,
-                epoch=self.epoch,
-                robot=self.robot,
-                robots=self.robots,
-                tasks=self.tasks,
-                costs=np.asarray(self.costs, dtype=np.float64),
-            )
-            self._cdr.append(bytes(store.serialize_cdr(message, BID_TABLE)))
-        return self._cdr[0]
-
-    def size_bytes(self) -> int:
-        """Bytes on the wire."""
-        return len(self.to_cdr())
+    stamp_ns: Time
+    epoch: uint32
+    robot: string
+    robots: uint32
+    tasks: uint32
+    costs: Float64s
 
 
 class AuctionAgent:

@@ -11,18 +11,16 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field
-from functools import lru_cache
+from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
-from rosbags.typesys import Stores, get_typestore
 
 from cosim.core.adapter import RunContext
 from cosim.core.bus import TopicQos
 from cosim.core.hosts import HostId
 from cosim.core.kernel import Stage
-from cosim.core.messages import Message
+from cosim.core.messages import Const, Message, ros_message, std
 from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns
 from cosim.scenario.fields import param
@@ -57,47 +55,27 @@ class RangeFinderSettings:
     range_max_m: float = param(4.0, "farthest reading (m)", gt=0, le=100)
 
 
-@lru_cache(maxsize=1)
-def _store() -> Any:
-    return get_typestore(Stores.ROS2_HUMBLE)
-
-
-@dataclass(frozen=True)
+@ros_message(
+    std.RANGE,
+    wire={
+        "header.stamp": "stamp_ns",
+        "header.frame_id": "frame_id",
+        "radiation_type": Const(ULTRASOUND),
+        "field_of_view": "field_of_view_rad",
+        "min_range": "range_min_m",
+        "max_range": "range_max_m",
+        "range": "range_m",
+    },
+)
 class Range(Message):
-    """``sensor_msgs/msg/Range``: one reading in the sensor's frame (m, rad)."""
+    """``sensor_msgs/msg/Range``: one ultrasonic reading in the sensor's frame (m, rad)."""
 
-    ros_type: ClassVar[str] = "sensor_msgs/msg/Range"
     stamp_ns: int
     frame_id: str
     field_of_view_rad: float
     range_min_m: float
     range_max_m: float
     range_m: float
-    _cdr: list[bytes] = field(default_factory=list, repr=False, compare=False)
-
-    def to_cdr(self) -> bytes:
-        """The reading as ROS 2 serializes it (rosbags' CDR serializer), made once."""
-        if not self._cdr:
-            store = _store()
-            time = store.types["builtin_interfaces/msg/Time"]
-            header = store.types["std_msgs/msg/Header"](
-                stamp=time(sec=self.stamp_ns // 1_000_000_000, nanosec=self.stamp_ns % 10**9),
-                frame_id=self.frame_id,
-            )
-            message = store.types[self.ros_type](
-                header=header,
-                radiation_type=ULTRASOUND,
-                field_of_view=self.field_of_view_rad,
-                min_range=self.range_min_m,
-                max_range=self.range_max_m,
-                range=self.range_m,
-            )
-            self._cdr.append(bytes(store.serialize_cdr(message, self.ros_type)))
-        return self._cdr[0]
-
-    def size_bytes(self) -> int:
-        """Bytes on the wire."""
-        return len(self.to_cdr())
 
 
 class RangeFinderAdapter:

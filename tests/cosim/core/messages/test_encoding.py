@@ -39,7 +39,7 @@ from cosim.core.messages import (
     Transform,
     Twist,
 )
-from cosim.recording.schemas import typestore
+from cosim.recording.schemas import register, typestore
 
 STORE = typestore()
 
@@ -101,7 +101,10 @@ EXAMPLES: list[Message] = [
             Marker("tasks", 1_000_003, MarkerType.TEXT_VIEW_FACING, text="task 3: robot_1"),
         ),
     ),
+    TaskInfo(3, 1.0, 2.0, ("robot_1",), "robot_2"),
 ]
+for _example in EXAMPLES:
+    register(type(_example).wire)
 
 
 def _roundtrip(message: Message) -> tuple[bytes, object]:

@@ -92,13 +92,17 @@ def _cosim_store():
     from rosbags.typesys import get_typestore
     from rosbags.typesys.msg import get_types_from_msg
 
-    from cosim.core.messages.definitions import DEFINITIONS
+    import cosim.core.messages as messages
 
     store = get_typestore(Stores.ROS2_JAZZY)
-    types = {}
-    for name, text in DEFINITIONS.items():
-        types.update(get_types_from_msg(text, name))
-    store.register(types)
+    declared = [getattr(messages, n) for n in messages.__all__]
+    for cls in declared:
+        wire = getattr(cls, "wire", None)
+        if wire is None or wire.ros_type.split("/")[0] != "cosim_msgs":
+            continue
+        for kind in [*wire.dependencies(), wire]:
+            if kind.ros_type not in store.fielddefs:
+                store.register(get_types_from_msg(kind.msg_text(), kind.ros_type))
     return store
 
 
