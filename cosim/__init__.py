@@ -21,7 +21,8 @@ from cosim.core.errors import (
     RegistryError,
     ScenarioError,
 )
-from cosim.runner.execute import RunResult, run
+from cosim.runner.execute import run
+from cosim.runner.result import RunResult
 from cosim.scenario import Scenario, load_scenario
 
 

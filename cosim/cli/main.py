@@ -74,7 +74,7 @@ def _tasks_phrase(s: dict[str, Any]) -> str | None:
 
 if TYPE_CHECKING:
     from cosim.recording.setup import RecordingSession
-    from cosim.runner.execute import RunResult
+    from cosim.runner.result import RunResult
     from cosim.runner.stopping import RunStopped, StopRequest
 
 EXIT_OK = 0
