@@ -6,23 +6,66 @@ The Python API for notebooks and study scripts::
     scenario = cosim.load_scenario("warehouse-random", overrides={"robots.count": 8})
     result = cosim.run(scenario, seed=3)
     result.summary["real_time_factor"], result.tables["poses"].head()
+
+The names of the package are imported from the modules that define them on first use
+(PEP 562), so importing one part of cosim (``cosim.core.bus``, the command line) loads
+neither pandas nor the runner.
 """
 
-from pathlib import Path
-from typing import Any
+from __future__ import annotations
 
-import pandas as pd
+import importlib
+from typing import TYPE_CHECKING, Any
 
-from cosim.core.errors import (
-    BridgeError,
-    ConfigError,
-    CosimError,
-    ExportError,
-    RegistryError,
-    ScenarioError,
-)
-from cosim.runner.execute import RunResult, run
-from cosim.scenario import Scenario, load_scenario
+if TYPE_CHECKING:
+    from pathlib import Path
+
+    import pandas as pd
+
+    from cosim.core.errors import (
+        BridgeError,
+        ConfigError,
+        CosimError,
+        ExportError,
+        RegistryError,
+        ScenarioError,
+    )
+    from cosim.runner.execute import run
+    from cosim.runner.result import RunResult
+    from cosim.scenario import Scenario, load_scenario
+
+_DEFINED_IN = {
+    "BridgeError": "cosim.core.errors",
+    "ConfigError": "cosim.core.errors",
+    "CosimError": "cosim.core.errors",
+    "ExportError": "cosim.core.errors",
+    "RegistryError": "cosim.core.errors",
+    "ScenarioError": "cosim.core.errors",
+    "RunResult": "cosim.runner.result",
+    "run": "cosim.runner.execute",
+    "Scenario": "cosim.scenario",
+    "load_scenario": "cosim.scenario",
+}
+"""The module that defines each name of the package, imported when the name is first used."""
+
+
+def __getattr__(name: str) -> Any:
+    """A name of the package, imported from the module that defines it (PEP 562).
+
+    Raises:
+        AttributeError: the package has no such name.
+    """
+    module = _DEFINED_IN.get(name)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value  # later uses find it without coming here
+    return value
+
+
+def __dir__() -> list[str]:
+    """The package's names, those not imported yet included."""
+    return sorted({*globals(), *_DEFINED_IN})
 
 
 def study(

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 import pytest
 
 import cosim
-from cosim.runner.execute import RunResult
+from cosim.runner.result import RunResult
 from cosim.scenario import Scenario
 
 if TYPE_CHECKING:

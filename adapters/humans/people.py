@@ -42,6 +42,7 @@ from typing import Any, ClassVar, Literal
 
 import numpy as np
 
+from adapters.humans.crowd import People
 from adapters.humans.files import (
     TrafficTypes,
     write_config,
@@ -71,30 +72,6 @@ WAIT_MPS = 0.05
 """A walker the speed model limits below this is waiting for a robot (m/s)."""
 CLEARANCE_MARGIN_M = 0.1
 """Aisle lines keep a worker's radius plus this from shelves and walls (m)."""
-
-
-class People:
-    """The people and forklifts now, for other adapters (markers, figures).
-
-    Attributes:
-        names: their ids.
-        kinds: ``person`` or ``forklift`` per id.
-        x_m, y_m, yaw_rad, speed_mps: their poses and speeds (``map``).
-        discs, disc_names: the (k, 3) discs ``x_m, y_m, radius_m`` that lidars and collision
-            checks see (two per forklift), and whose each disc is.
-    """
-
-    def __init__(self) -> None:
-        self.names: list[str] = []
-        self.kinds: list[str] = []
-        self.x_m = np.zeros(0)
-        self.y_m = np.zeros(0)
-        self.yaw_rad = np.zeros(0)
-        self.speed_mps = np.zeros(0)
-        self.discs = np.zeros((0, 3))
-        self.disc_names: list[str] = []
-        self.forklift_size_m = (0.0, 0.0)
-        self.worker_radius_m = 0.0
 
 
 class HumansAdapter:

@@ -22,7 +22,7 @@ from models.humans.encounters import HALT_MPS, Encounters
 from models.tasks.book import TaskStatus
 
 if TYPE_CHECKING:
-    from adapters.humans.people import People
+    from adapters.humans.crowd import People
 
 HUMANS = TableSpec(
     "humans",

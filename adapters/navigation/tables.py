@@ -2,7 +2,7 @@
 
 ``plan_ms`` is the wall-clock time of a plan, a column that is not a function of the
 scenario and seed; it is registered as volatile, and runs are compared without it
-(:meth:`cosim.runner.execute.RunResult.deterministic_tables`).
+(:meth:`cosim.runner.result.RunResult.deterministic_tables`).
 """
 
 from __future__ import annotations

@@ -32,7 +32,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from adapters.fleet.motion import FleetAdapter
-from adapters.humans.people import People
+from adapters.humans.crowd import People
 from adapters.naming import topic
 from adapters.recording.poses import PosesAdapter
 from adapters.tasks.topics import TASKS

@@ -74,7 +74,7 @@ def _tasks_phrase(s: dict[str, Any]) -> str | None:
 
 if TYPE_CHECKING:
     from cosim.recording.setup import RecordingSession
-    from cosim.runner.execute import RunResult
+    from cosim.runner.result import RunResult
     from cosim.runner.stopping import RunStopped, StopRequest
 
 EXIT_OK = 0
@@ -324,7 +324,7 @@ def _cmd_world(args: argparse.Namespace) -> int:
 def _cmd_study(args: argparse.Namespace) -> int:
     from cosim.studies.lifeline import StudyStopped, stop_on_signals
     from cosim.studies.runner import Progress, run_study
-    from cosim.studies.spec import load_study
+    from cosim.studies.validate import load_study
 
     # SIGTERM stops a study as Ctrl-C does: finished runs kept, one line, 128 + the signal
     try:

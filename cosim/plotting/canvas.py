@@ -45,16 +45,6 @@ def save_png(figure: Figure, png_path: Path, *, dpi: float = DPI) -> Path:
     return png_path
 
 
-def robot_order(names: Iterable[str]) -> list[str]:
-    """Robot names in fleet order: ``robot_2`` before ``robot_10`` (numbers compared as such)."""
-
-    def key(name: str) -> tuple[str, int, str]:
-        match = re.fullmatch(r"(.*?)(\d+)", name)
-        return (match.group(1), int(match.group(2)), "") if match else (name, -1, name)
-
-    return sorted(set(names), key=key)
-
-
 PHYSICAL_COLOR: Color = (0.84, 0.15, 0.16, 1.0)
 """A physical robot's twin, red as in the paper's mixed-reality figures (and only it)."""
 _TAB10_NOT_RED = (0, 1, 2, 4, 5, 6, 8, 9, 7)

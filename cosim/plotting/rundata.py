@@ -9,6 +9,8 @@ required; tasks, messages and assignments are optional (older runs, other driver
 
 from __future__ import annotations
 
+import re
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -17,7 +19,6 @@ import pandas as pd
 
 from adapters.world.warehouse import scenario_warehouse
 from cosim.core.errors import ExportError
-from cosim.plotting.canvas import robot_order
 from cosim.plotting.ownership import task_holds
 from cosim.scenario import Scenario, load_scenario
 from models.arrays import FloatArray
@@ -54,6 +55,16 @@ _NAMES = (
     "detail",
 )
 """Columns of names (categorical in the tables), read as plain strings."""
+
+
+def robot_order(names: Iterable[str]) -> list[str]:
+    """Robot names in fleet order: ``robot_2`` before ``robot_10`` (numbers compared as such)."""
+
+    def key(name: str) -> tuple[str, int, str]:
+        match = re.fullmatch(r"(.*?)(\d+)", name)
+        return (match.group(1), int(match.group(2)), "") if match else (name, -1, name)
+
+    return sorted(set(names), key=key)
 
 
 @dataclass(frozen=True)

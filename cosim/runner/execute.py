@@ -6,18 +6,16 @@ import contextlib
 import platform
 import time
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass, field
 from importlib.metadata import version
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pandas as pd
 
 from cosim.core.adapter import AdapterType
-from cosim.core.errors import BridgeError, CosimError, RegistryError
+from cosim.core.errors import BridgeError, RegistryError
 from cosim.core.kernel import Lateness
-from cosim.core.recorder import MapArtifact, Recorder, merge_counts
+from cosim.core.recorder import Recorder, merge_counts
 from cosim.core.registry import AdapterRegistry
 from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S, s_to_ns
@@ -28,6 +26,7 @@ from cosim.recording.unity import UnityOptions
 from cosim.runner.assembly import Assembly, assemble
 from cosim.runner.compiletime import CompileClock
 from cosim.runner.outfolder import prepare_out, write_run
+from cosim.runner.result import RunResult
 from cosim.runner.stopping import CHECK_EVERY_S, RunStopped, StopRequest, signal_name
 from cosim.scenario.model import Scenario
 
@@ -36,49 +35,6 @@ ProgressFn = Callable[[float, float, float], None]
 
 PROGRESS_EVERY_S = 0.5
 """Wall-clock seconds between progress calls."""
-
-
-@dataclass
-class RunResult:
-    """The outcome of a run.
-
-    Attributes:
-        scenario: the scenario that ran (with its seed and duration).
-        summary: flat metrics and provenance.
-        tables: DataFrames by table name (``poses``, ``messages``, ``events``, ...).
-        out: the run folder, when written.
-        bag: the bag directory, when one was written.
-        recorded: messages recorded per topic (bag or live view).
-        maps: final occupancy maps by name (written as ``maps/NAME.yaml`` + ``.pgm``).
-        files: other files for the run folder by relative path (SUMO's ``sumo/...``).
-        stopped: the signal that stopped the run before its duration, or None (the
-            summary then says ``"stopped"`` and the simulated time reached).
-        failure: the error of an external system that ended the run early (a robot or a
-            motion-capture server gone silent), or None; the summary then says ``"failed"``.
-        compile_time_s: wall-clock seconds numba spent compiling kernels for this run (s;
-            about 13 s on a machine's first run, 0 once they are cached); the summary's
-            ``wall_time_s`` and ``real_time_factor`` leave it out.
-    """
-
-    scenario: Scenario
-    summary: dict[str, Any]
-    tables: dict[str, pd.DataFrame] = field(repr=False)
-    out: Path | None = None
-    volatile: dict[str, tuple[str, ...]] = field(default_factory=dict, repr=False)
-    bag: Path | None = None
-    recorded: dict[str, int] = field(default_factory=dict, repr=False)
-    maps: dict[str, MapArtifact] = field(default_factory=dict, repr=False)
-    files: dict[str, bytes] = field(default_factory=dict, repr=False)
-    stopped: int | None = None
-    failure: CosimError | None = field(default=None, repr=False)
-    compile_time_s: float = 0.0
-
-    def deterministic_tables(self) -> dict[str, pd.DataFrame]:
-        """The tables without their wall-clock columns: equal for equal scenario and seed."""
-        return {
-            name: frame.drop(columns=list(self.volatile.get(name, ())))
-            for name, frame in self.tables.items()
-        }
 
 
 def cosim_version() -> str:

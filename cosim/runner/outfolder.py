@@ -30,7 +30,7 @@ from cosim.scenario.loader import dump_scenario
 from models.geometry.occupancy import OccupancyGrid
 
 if TYPE_CHECKING:
-    from cosim.runner.execute import RunResult
+    from cosim.runner.result import RunResult
 
 TOP_FILES = ("summary.json", "scenario.toml")
 """The files a run writes at the top of its folder."""

@@ -34,14 +34,14 @@ def warm_up(presets: Sequence[str] | None = None) -> float:
     Returns:
         Wall-clock seconds numba spent compiling (0 when every kernel was cached already).
     """
-    import cosim
     from cosim.runner.execute import run
+    from cosim.scenario import load_scenario
 
     compiled_s = 0.0
     for name, duration_s, overrides in WARMUPS:
         if presets is not None and name not in presets:
             continue
-        scenario = cosim.load_scenario(name, overrides=overrides)
+        scenario = load_scenario(name, overrides=overrides)
         scenario = scenario.with_duration(duration_s)
         compiled_s += run(scenario).compile_time_s
     return compiled_s

@@ -2,10 +2,8 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Sequence
 from pathlib import Path
-from types import MappingProxyType
 
 import numpy as np
 import pandas as pd
@@ -23,6 +21,7 @@ from cosim.studies.analysis import (
     standard_figures,
     write_report,
 )
+from cosim.studies.derived import DERIVED_METRICS
 from cosim.studies.folder import write_results
 from cosim.studies.labels import axis_label, short_label
 from cosim.studies.spec import StudySpec
@@ -40,43 +39,10 @@ MAX_X_TICKS = 12
 """Log-log figures label up to this many x values themselves, beyond it powers of ten."""
 
 
-@dataclass(frozen=True)
-class DerivedMetric:
-    """A metric computed from each run's summary metrics when the report names it.
-
-    Attributes:
-        inputs: the summary metrics it needs.
-        formula: how it is computed, for the report.
-        compute: the metric per row of the results (NaN where it is undefined).
-    """
-
-    inputs: tuple[str, ...]
-    formula: str
-    compute: Callable[[pd.DataFrame], pd.Series]
-
-
-def _wall_us_per_robot_s(results: pd.DataFrame) -> pd.Series:
-    robot_s = results["robots"].astype(float) * results["sim_time_s"].astype(float)
-    return 1e6 * results["wall_time_s"].astype(float) / robot_s.where(robot_s > 0)
-
-
-DERIVED_METRICS: Mapping[str, DerivedMetric] = MappingProxyType(
-    {
-        "wall_us_per_robot_s": DerivedMetric(
-            inputs=("wall_time_s", "robots", "sim_time_s"),
-            formula="wall-clock microseconds per simulated robot-second, "
-            "1e6 x wall_time_s / (robots x sim_time_s)",
-            compute=_wall_us_per_robot_s,
-        ),
-    }
-)
-"""Metrics a ``[report]`` may name besides the runs' own, by name."""
-
-
 def report_study(spec: StudySpec, out: Path) -> Path:
     """Write ``figures/*.png`` and ``report.md`` for a finished (or partial) study.
 
-    Derived metrics the report names (:data:`DERIVED_METRICS`) are added to
+    Derived metrics the report names (:data:`~cosim.studies.derived.DERIVED_METRICS`) are added to
     ``results.parquet`` as columns first, so the tables, the figures and later analysis of
     the folder all see them. Metrics in ``loglog`` get a table and a log-log figure
     ``<metric>_vs_<x>_loglog.png``; a linear one only if ``metrics`` names them too.

@@ -110,7 +110,7 @@ def run_study(
     """Run a study and return its results (one row per run).
 
     Args:
-        spec: from :func:`~cosim.studies.spec.load_study`.
+        spec: from :func:`~cosim.studies.validate.load_study`.
         out: the study folder.
         workers: local processes (default: the machine's cores); ignored with ``scheduler``.
         scheduler: address of a Dask scheduler (``tcp://host:port``) to run on instead.

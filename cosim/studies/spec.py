@@ -34,9 +34,10 @@ results without being run, so it is refused. So are grids and cases over ``recor
 that study runs ignore (they write no bag; ``tables`` decides the tables kept).
 
 Every combination is loaded as a scenario before the study starts, and its adapters check
-the sections they need together (:mod:`cosim.studies.validate`), so a bad key or value, a
-combination that cannot run, or a report metric no run reports is named (file, key, value,
-expectation) and nothing runs.
+the sections they need together (:func:`cosim.studies.validate.load_study` reads the file
+with :func:`read_study`, then validates it), so a bad key or value, a combination that
+cannot run, or a report metric no run reports is named (file, key, value, expectation) and
+nothing runs.
 """
 
 from __future__ import annotations
@@ -53,7 +54,6 @@ from cosim.scenario.fields import show_name, show_value, suggest
 from cosim.scenario.loader import preset_names
 from cosim.scenario.tomlfile import read_toml_file
 from cosim.studies.reportspec import REPORT_KEYS, check_report, check_timeseries
-from cosim.studies.validate import validate_study
 
 SECTIONS = ("study", "grid", "overrides", "cases", "report")
 STUDY_KEYS = ("name", "scenario", "seeds", "duration_s", "tables", "description")
@@ -158,17 +158,6 @@ def _dotted(path: Path, section: str, table: Any) -> dict[str, Any]:
                 path, section, f'key {key!r}: expected "section.key", e.g. "network.latency_ms"'
             )
     return dict(table)
-
-
-def load_study(path: str | Path) -> StudySpec:
-    """Read and validate a study file (every combination is checked as a scenario).
-
-    Raises:
-        ConfigError: naming the file, the section, the key, the value and what was expected.
-    """
-    spec = read_study(path)
-    validate_study(spec)
-    return spec
 
 
 def read_study(path: str | Path) -> StudySpec:

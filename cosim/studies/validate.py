@@ -1,17 +1,18 @@
-"""A study's combinations, checked before any run: each loads and can run.
+"""Loading a study: its file read (:func:`cosim.studies.spec.read_study`), then checked.
 
-Every combination is loaded as a scenario and its adapters check the sections they need
-together (:func:`cosim.runner.assembly.check_scenario`). When the study keeps named tables
-or its ``[report]`` names metrics, tables or columns, one scenario per distinct set of
-adapters is also run for a millisecond: adapters create some tables only when they finish,
-and summary metrics are known only from a run, so a name no run would produce is reported
-now rather than after the whole study.
+Before any run, every combination is loaded as a scenario (each must load and be able to
+run) and its adapters check the sections they need together
+(:func:`cosim.runner.assembly.check_scenario`). When the study keeps named tables or its
+``[report]`` names metrics, tables or columns, one scenario per distinct set of adapters is
+also run for a millisecond: adapters create some tables only when they finish, and summary
+metrics are known only from a run, so a name no run would produce is reported now rather
+than after the whole study.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import TYPE_CHECKING
+from pathlib import Path
 
 from cosim.core.errors import ConfigError
 from cosim.core.registry import AdapterRegistry
@@ -19,11 +20,10 @@ from cosim.runner.assembly import adapter_names, check_scenario
 from cosim.runner.execute import execute
 from cosim.scenario import Scenario, load_scenario
 from cosim.scenario.fields import show_value
+from cosim.studies.derived import DERIVED_METRICS
 from cosim.studies.reportspec import RunColumns, check_report_names, names_to_check, study_keys
+from cosim.studies.spec import StudySpec, read_study
 from cosim.studies.worker import run_overrides
-
-if TYPE_CHECKING:
-    from cosim.studies.spec import StudySpec
 
 PROBE_S = 0.001
 """Simulated seconds of the probe run that shows a set of adapters' tables and metrics."""
@@ -61,6 +61,17 @@ def _in_study(spec: StudySpec, error: ConfigError) -> ConfigError:
     return ConfigError(f"{spec.path}: [study] scenario = {spec.scenario!r}: {text}")
 
 
+def load_study(path: str | Path) -> StudySpec:
+    """Read and validate a study file (every combination is checked as a scenario).
+
+    Raises:
+        ConfigError: naming the file, the section, the key, the value and what was expected.
+    """
+    spec = read_study(path)
+    validate_study(spec)
+    return spec
+
+
 def validate_study(spec: StudySpec) -> None:
     """Load and check every combination, and the names the study asks its runs for.
 
@@ -89,8 +100,6 @@ def validate_study(spec: StudySpec) -> None:
 
 def probe(scenarios: list[Scenario]) -> RunColumns:
     """Summary metrics and table columns of a millisecond run per distinct set of adapters."""
-    from cosim.studies.reporting import DERIVED_METRICS  # matplotlib: only when a report asks
-
     seen: set[tuple[str, ...]] = set()
     metrics: set[str] = set()
     tables: dict[str, set[str]] = {}

@@ -9,8 +9,8 @@ once in every worker.
 
 from __future__ import annotations
 
-import cosim
 from cosim.runner.execute import execute
+from cosim.scenario import load_scenario
 from cosim.studies.lifeline import bind_fork_server
 
 _TINY = {
@@ -24,4 +24,4 @@ _TINY = {
 }
 
 bind_fork_server()
-execute(cosim.load_scenario("warehouse-random", _TINY))
+execute(load_scenario("warehouse-random", _TINY))

@@ -13,8 +13,8 @@ import pandas as pd
 import pytest
 
 import cosim
+from adapters.humans.crowd import People
 from adapters.humans.files import sumo_tool
-from adapters.humans.people import People
 from adapters.naming import topic
 from adapters.world.warehouse import scenario_warehouse
 from cosim.cli.main import main

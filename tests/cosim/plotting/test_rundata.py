@@ -5,7 +5,12 @@ import pandas as pd
 import pytest
 
 from cosim.plotting.assignment import epoch_stats
-from cosim.plotting.rundata import load_run
+from cosim.plotting.rundata import load_run, robot_order
+
+
+def test_robot_names_come_in_fleet_order_numbers_compared_as_numbers_once_each():
+    names = ["robot_10", "robot_2", "robot_1", "robot_2", "mocap", "robot_12"]
+    assert robot_order(names) == ["mocap", "robot_1", "robot_2", "robot_10", "robot_12"]
 
 
 def test_the_track_holds_every_robot_in_fleet_order_on_one_time_base(task_run):

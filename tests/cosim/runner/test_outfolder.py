@@ -5,8 +5,8 @@ import pytest
 
 import cosim
 from cosim.core.errors import ExportError
-from cosim.runner.execute import RunResult
 from cosim.runner.outfolder import default_out, prepare_out, write_run
+from cosim.runner.result import RunResult
 
 EARLIER = [
     "summary.json",

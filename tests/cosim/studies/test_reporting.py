@@ -10,12 +10,8 @@ import pytest
 
 from cosim.core.errors import ConfigError
 from cosim.studies import load_study, run_study
-from cosim.studies.reporting import (
-    DERIVED_METRICS,
-    loglog_figure,
-    loglog_figures,
-    report_study,
-)
+from cosim.studies.derived import DERIVED_METRICS
+from cosim.studies.reporting import loglog_figure, loglog_figures, report_study
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 X = "robots.count"
@@ -82,16 +78,6 @@ ROWS = [
     _row(50, 1, 5.0),
     _row(50, 2, 6.0),
 ]
-
-
-def test_wall_us_per_robot_s_is_wall_time_over_robots_times_sim_time_in_microseconds():
-    frame = pd.DataFrame(
-        {"wall_time_s": [2.0, 0.5, 1.0], "robots": [50, 4, 0], "sim_time_s": [20.0, 10.0, 10.0]}
-    )
-    values = DERIVED_METRICS["wall_us_per_robot_s"].compute(frame)
-    assert values[0] == pytest.approx(2000.0)  # 2 s / (50 x 20 robot-s)
-    assert values[1] == pytest.approx(12500.0)
-    assert np.isnan(values[2])  # no robot: undefined, not infinite
 
 
 def test_a_report_naming_a_derived_metric_adds_it_to_the_results_exactly(tmp_path):
