@@ -1,12 +1,15 @@
 """A measured pose off the map: the robot stops, the navigation records it, nothing raises."""
 
 from collections.abc import Mapping
+from types import SimpleNamespace
 from typing import Any, ClassVar
 
+import numpy as np
 import pytest
 
 import cosim
 from adapters.mocap.intake import pose_topic
+from adapters.navigation.off_map import OffMapWatch
 from cosim.core.adapter import RunContext
 from cosim.core.hosts import HostId
 from cosim.core.kernel import Stage
@@ -79,3 +82,69 @@ def test_a_robot_whose_pose_is_off_the_map_stops_records_it_and_drives_on_when_i
     poses = result.tables["poses"]
     standing = poses[(poses.t_s >= OFF_FROM_S + 0.5) & (poses.t_s <= OFF_TO_S)]
     assert standing.v_mps.abs().max() == 0.0
+
+
+RUN: Any = SimpleNamespace()
+"""The run: only the planner, a stand-in here, would read it."""
+
+
+class Kept:
+    """Stands in for the navigation table and the planner: keeps rows and plans asked for."""
+
+    def __init__(self) -> None:
+        self.rows: list[tuple[Any, ...]] = []
+        self.plans: list[tuple[int, int, bool]] = []
+
+    def row(self, now_ns: int, i: int, event: str, x: float, y: float, *, detail: str) -> None:
+        self.rows.append((now_ns, i, event, x, y, detail))
+
+    def plan(self, run: Any, i: int, now_ns: int, *, replan: bool) -> None:
+        self.plans.append((i, now_ns, replan))
+
+
+def _watch(pose: np.ndarray, *, replan: bool = True) -> tuple[OffMapWatch, Kept]:
+    """A watch over a 10 m x 5 m costmap of 0.1 m cells from (-1, -1); both robots have goals."""
+    static: Any = SimpleNamespace(origin_xy_m=(-1.0, -1.0), resolution_m=0.1, width=100, height=50)
+    goals: Any = SimpleNamespace(
+        goal=np.array([[2.0, 3.0], [4.0, 1.0]]), active=np.array([True, True])
+    )
+    kept: Any = Kept()
+    watch = OffMapWatch(static, pose, goals, kept, kept, replan=replan)
+    return watch, kept
+
+
+def test_a_robot_leaving_the_costmap_is_off_and_recorded_once():
+    pose = np.array([[0.0, 0.0, 0.0], [8.0, 3.0, 0.0]])
+    watch, kept = _watch(pose)
+    assert watch.check(RUN, 1).tolist() == [False, False]
+    pose[1] = (9.05, 3.0, 0.0)  # beyond the last cell (x < 9 m)
+    assert watch.check(RUN, 2).tolist() == [False, True]
+    assert watch.check(RUN, 3).tolist() == [False, True]
+    assert kept.rows == [
+        (2, 1, "off_map", 4.0, 1.0, "pose (9.05, 3.00) m outside the 100x50 costmap: stopped")
+    ]
+    assert kept.plans == []
+
+
+def test_a_robot_whose_pose_is_not_a_number_is_off_the_costmap():
+    watch, _ = _watch(np.array([[np.nan, 0.0, 0.0], [0.0, -1.01, 0.0]]))
+    assert watch.check(RUN, 1).tolist() == [True, True]
+
+
+def test_a_robot_back_on_the_costmap_with_a_goal_plans_again_at_once():
+    pose = np.array([[-30.0, 40.0, 0.0], [0.0, 0.0, 0.0]])
+    watch, kept = _watch(pose)
+    watch.check(RUN, 1)
+    pose[0] = (0.5, 0.5, 0.0)
+    assert not watch.check(RUN, 2).any()
+    assert kept.rows[-1] == (2, 0, "on_map", 2.0, 3.0, "pose (0.50, 0.50) m: back on the costmap")
+    assert kept.plans == [(0, 2, True)]
+
+
+def test_a_robot_back_on_the_costmap_plans_nothing_when_a_fleet_manager_moves_it():
+    pose = np.array([[-30.0, 40.0, 0.0], [0.0, 0.0, 0.0]])
+    watch, kept = _watch(pose, replan=False)
+    watch.check(RUN, 1)
+    pose[0] = (0.5, 0.5, 0.0)
+    watch.check(RUN, 2)
+    assert [row[2] for row in kept.rows] == ["off_map", "on_map"] and kept.plans == []

@@ -1,85 +1,115 @@
-"""The checks a loop closure passes before and after it enters the pose graph."""
+"""Loop closure as the mapper uses it: updates in, a re-solved pose and a rebuilt map out.
+
+The checks a closure passes are tested in ``test_closure_checks.py``, the search in
+``test_loop_search.py`` and the graph of updates in ``test_update_graph.py``.
+"""
 
 import math
+from dataclasses import replace
 
 import numpy as np
-import pytest
 
-from models.geometry.se2 import compose, relative
+from models.geometry.se2 import compose
+from models.mapping.grid import LogOddsMap
 from models.mapping.loops import LoopCloser, LoopParams
-from models.mapping.posegraph import Edge, sqrt_information
+from tests.models.mapping.conftest import LAP, MATCHED, ROOM, Lidar, integrate, room_map
 
-ANGLES = np.linspace(-math.pi, math.pi, 8, endpoint=False)
-MATCHED = np.diag([0.02**2, 0.02**2, 0.005**2])  # a scan match's covariance
+LIDAR = Lidar(ROOM)
+TRUTH = LAP + LAP[:20]
+"""A lap of the room (25 m) and half of it again."""
 
 
-def _out_and_back() -> LoopCloser:
-    """40 nodes: 10 m east in 0.5 m steps, a U-turn, and back west 2 m to the north."""
+def _drive(
+    sideways_per_node_m: float, params: LoopParams | None = None, nodes: int = len(TRUTH)
+) -> tuple[LoopCloser, LogOddsMap, list[tuple[int, tuple[float, float, float]]]]:
+    """Updates along ``TRUTH`` whose estimates drift to the left from the sixth on.
+
+    Returns:
+        The loop closer, the map it rebuilds, and every (node, re-solved pose) it returned.
+    """
     closer = LoopCloser(
-        LoopParams(), ANGLES, range_min_m=0.1, range_max_m=10.0, clear_no_return_m=3.0
-    )
-    poses = [(0.5 * k, 0.0, 0.0) for k in range(20)] + [
-        (9.5 - 0.5 * k, 2.0, math.pi) for k in range(20)
-    ]
-    for pose in poses:
-        closer.add(pose, pose, np.full(len(ANGLES), 5.0, np.float32), True, MATCHED)
-    return closer
+        params or LoopParams(), LIDAR.angles, range_min_m=0.1, range_max_m=10.0,
+        clear_no_return_m=3.0,
+    )  # fmt: skip
+    grid = room_map()
+    solved = []
+    for k, pose in enumerate(TRUTH[:nodes]):
+        estimate = compose(pose, (0.0, sideways_per_node_m * max(0, k - 5), 0.0))
+        integrate(grid, LIDAR, estimate)
+        closer.add(estimate, pose, LIDAR.scan(pose), True, MATCHED)
+        closed = closer.close(grid)
+        if closed is not None:
+            solved.append((k, closed))
+    return closer, grid, solved
 
 
-def _closure(closer: LoopCloser, a: int, b: int, error=(0.0, 0.0, 0.0), sigma_m=0.05) -> Edge:
-    """Node ``b`` seen from node ``a``, off from where the graph has it by ``error``."""
-    z = compose(relative(closer.graph.nodes[a], closer.graph.nodes[b]), error)
-    cov = np.diag([sigma_m**2, sigma_m**2, 0.02**2])
-    return Edge(a, b, z, 0.0, 0.0, sqrt_information(cov))
+def _counts(closer: LoopCloser) -> tuple[int, int, int, int, int]:
+    return (
+        closer.closures, closer.not_needed, closer.waiting, closer.implausible, closer.rejected
+    )  # fmt: skip
 
 
-def test_a_closure_the_path_could_have_drifted_into_is_plausible():
-    closer = _out_and_back()
-    assert closer._plausible(_closure(closer, 2, 37, (0.3, -0.2, 0.03)))
+def test_no_loop_is_found_before_the_path_is_long_enough_to_come_back():
+    closer, _, solved = _drive(0.0, nodes=16)  # 9.4 m of path: under min_path_m
+    assert solved == [] and _counts(closer) == (0, 0, 0, 0, 0)
 
 
-def test_a_closure_asking_for_more_drift_than_the_path_allows_is_not():
-    closer = _out_and_back()
-    # 30 m of matched steps cannot have drifted 4 m: that place only looks the same
-    assert not closer._plausible(_closure(closer, 2, 37, (4.0, 0.0, 0.0)))
+def test_loops_are_searched_at_most_every_every_nodes_updates():
+    closer = LoopCloser(
+        replace(LoopParams(), every_nodes=3), LIDAR.angles, range_min_m=0.1, range_max_m=10.0,
+        clear_no_return_m=3.0,
+    )  # fmt: skip
+    searched = []
+    candidates = closer.search.candidates
+
+    def spied(poses: np.ndarray, k: int) -> tuple[int, list[int]] | None:
+        searched.append(k)
+        return candidates(poses, k)
+
+    closer.search.candidates = spied  # type: ignore[method-assign]
+    for pose in TRUTH[:12]:
+        closer.add(pose, pose, LIDAR.scan(pose), True, MATCHED)
+        closer.close(room_map())
+    assert searched == [2, 5, 8, 11]
 
 
-def test_a_closure_the_estimate_already_agrees_with_corrects_nothing():
-    closer = _out_and_back()
-    assert closer._correction(_closure(closer, 2, 37, (0.02, 0.0, 0.0))) < 1.0
-    assert closer._correction(_closure(closer, 2, 37, (0.3, 0.0, 0.0))) > 16.0
+def test_a_revisit_the_estimate_already_agrees_with_is_recognised_but_not_added():
+    closer, _, solved = _drive(0.0)
+    assert closer.not_needed > 0 and closer.closures == 0
+    assert solved == [] and not any(closer.updates.loop_edges)
 
 
-def test_two_closures_of_one_revisit_agree_and_an_aliased_one_does_not():
-    closer = _out_and_back()
-    drifted = (0.4, -0.1, 0.02)
-    first = _closure(closer, 2, 35, drifted)
-    again = _closure(closer, 3, 36, drifted)
-    aliased = _closure(closer, 3, 36, (1.5, -0.1, 0.02))  # a door frame 1.1 m further on
-    assert closer._agree(first, again)
-    assert not closer._agree(first, aliased)
+def test_a_drifted_revisit_is_closed_and_the_newest_pose_comes_back_nearer_the_truth():
+    closer, _, solved = _drive(0.005)
+    assert closer.closures > 0 and sum(closer.updates.loop_edges) == closer.closures
+    for k, pose in solved:
+        drifted = compose(TRUTH[k], (0.0, 0.005 * (k - 5), 0.0))
+        assert math.dist(pose[:2], TRUTH[k][:2]) < math.dist(drifted[:2], TRUTH[k][:2])
+    assert closer.graph.nodes[solved[-1][0]] == solved[-1][1]
 
 
-def test_a_corridor_match_constrains_nothing_along_the_corridor():
-    closer = _out_and_back()
-    along_x = np.diag([0.3**2, 0.02**2, 0.01**2])  # the match's spread, map axes
-    edge = closer._closure(2, 37, closer.graph.nodes[37], along_x)
-    covariance = np.linalg.inv(edge.whitening().T @ edge.whitening())
-    assert math.sqrt(covariance[0, 0]) == pytest.approx(LoopParams().ambiguous_sigma_m)
-    assert math.sqrt(covariance[1, 1]) == pytest.approx(0.02)
+def test_a_map_moved_by_a_solve_is_rebuilt_from_every_scan_at_its_solved_pose():
+    always = replace(LoopParams(), rebuild_shift_m=0.0)
+    _, _, solved = _drive(0.005, always)
+    first = solved[0][0]
+    closer, grid, _ = _drive(0.005, always, nodes=first + 1)  # up to the first solve
+    rebuilt = room_map()
+    for pose, node in zip(closer.graph.nodes, closer.nodes, strict=True):
+        rebuilt.integrate(
+            pose, LIDAR.angles, node.ranges, range_min_m=0.1, range_max_m=10.0,
+            clear_no_return_m=3.0,
+        )  # fmt: skip
+    assert closer.graph.nodes[first] == solved[0][1]
+    assert np.array_equal(grid.logodds, rebuilt.logodds)
 
 
-def test_a_step_is_as_sure_as_odometry_and_matching_together():
-    closer = _out_and_back()
-    fused = np.linalg.inv(closer.steps[5])
-    odometry = np.linalg.inv(closer._odometry_covariance((0.5, 0.0, 0.0)))
-    assert np.allclose(fused, odometry + np.linalg.inv(MATCHED))
+def test_a_revisit_asking_for_more_drift_than_the_path_allows_is_refused():
+    closer, _, solved = _drive(0.02)
+    assert closer.implausible > 0 and closer.closures == 0 and solved == []
+    assert len(closer.graph.edges) == len(TRUTH) - 1
 
 
-def test_the_chain_covariance_grows_with_the_path_and_its_lever():
-    closer = _out_and_back()
-    near, far = closer._chain_covariance(0, 5), closer._chain_covariance(0, 19)
-    along, sideways = far[0, 0] / near[0, 0], far[1, 1] / near[1, 1]
-    assert along == pytest.approx(19 / 5, rel=0.01)  # step variances add up
-    assert sideways > 2 * along  # and heading errors swing the far end further
-    assert np.all(np.linalg.eigvalsh(far) > 0)
+def test_the_graph_and_its_nodes_are_those_of_the_updates():
+    closer, _, _ = _drive(0.0, nodes=3)
+    assert closer.graph is closer.updates.graph and closer.nodes is closer.updates.nodes
+    assert [node.odom for node in closer.nodes] == TRUTH[:3]
