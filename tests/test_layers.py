@@ -1,9 +1,11 @@
 """The floors of the house (docs/architecture.md), checked on the import statements of every module.
 
-``models/`` is pure; ``cosim/core/`` is what adapters rely on and imports no other floor;
-``cosim/scenario/`` sits on the core; adapters use the core and the scenario, never the
-user's shell (command line, runner, studies, recording, plotting); clients of outside
-systems live with their capability in ``adapters/``, never in ``cosim/``.
+``models/`` is pure; ``cosim/core/`` is what adapters rely on, on the standard library,
+simpy and numpy alone; ``cosim/scenario/`` sits on the core; adapters use the core and the
+scenario, never the user's shell (command line, runner, studies, recording, plotting);
+clients of outside systems live with their capability in ``adapters/``, never in
+``cosim/``. No two files, and no two capability folders, import each other in a loop
+(imports inside functions and under ``TYPE_CHECKING`` count).
 """
 
 import ast
@@ -93,6 +95,117 @@ def test_no_module_of_cosim_talks_to_an_outside_system_itself(path):
 def test_every_module_stays_under_500_lines(path):
     lines = len(path.read_text().splitlines())
     assert lines <= LONGEST_MODULE, f"{path} has {lines} lines: split it by concept"
+
+
+def _module_name(path: Path) -> str:
+    parts = list(path.relative_to(ROOT).with_suffix("").parts)
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+MODULES = {
+    _module_name(p): p for p in _modules("cosim") + _modules("adapters") + _modules("models")
+}
+
+
+def _resolve(name: str) -> str | None:
+    """The module of ours that ``name`` (a module or a name in one) is, or None."""
+    while name and name not in MODULES:
+        name = name.rpartition(".")[0]
+    return name or None
+
+
+def _graph() -> dict[str, set[str]]:
+    """Module -> the modules of ours it imports, anywhere in it."""
+    graph = {}
+    for name, path in MODULES.items():
+        targets = set()
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Import):
+                found = [alias.name for alias in node.names]
+            elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+                found = [f"{node.module}.{alias.name}" for alias in node.names]
+            else:
+                continue
+            for imported in found:
+                if imported.split(".")[0] in ("cosim", "models", "adapters"):
+                    target = imported if imported in MODULES else _resolve(imported)
+                    if target is not None and target != name:
+                        targets.add(target)
+        graph[name] = targets
+    return graph
+
+
+def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected components of more than one node (Tarjan)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    found: list[list[str]] = []
+
+    def visit(node: str) -> None:
+        index[node] = low[node] = len(index)
+        stack.append(node)
+        on_stack.add(node)
+        for other in sorted(graph.get(node, ())):
+            if other not in index:
+                visit(other)
+                low[node] = min(low[node], low[other])
+            elif other in on_stack:
+                low[node] = min(low[node], index[other])
+        if low[node] == index[node]:
+            component = []
+            while True:
+                other = stack.pop()
+                on_stack.discard(other)
+                component.append(other)
+                if other == node:
+                    break
+            if len(component) > 1:
+                found.append(sorted(component))
+
+    for node in sorted(graph):
+        if node not in index:
+            visit(node)
+    return found
+
+
+def capability(module: str) -> str:
+    """The folder a module belongs to: ``adapters.<capability>``, ``models.<capability>``,
+    ``cosim.core`` (with its messages) or a package of the shell; a file at a floor's root
+    is its own."""
+    parts = module.split(".")
+    if parts[:2] == ["cosim", "core"]:
+        return "cosim.core"
+    if len(parts) >= 3 or ROOT.joinpath(*parts).is_dir():
+        return ".".join(parts[:2])
+    return module
+
+
+def test_no_files_import_each_other_in_a_loop():
+    assert _cycles(_graph()) == []
+
+
+def test_no_capability_folders_import_each_other_in_a_loop():
+    folders: dict[str, set[str]] = {}
+    for module, targets in _graph().items():
+        mine = capability(module)
+        folders.setdefault(mine, set()).update(
+            capability(t) for t in targets if capability(t) != mine
+        )
+    assert _cycles(folders) == []
+
+
+def test_the_cycle_check_finds_a_loop_and_a_loop_through_three():
+    assert _cycles({"a": {"b"}, "b": {"a"}, "c": set()}) == [["a", "b"]]
+    assert _cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == [["a", "b", "c"]]
+    assert _cycles({"a": {"b"}, "b": {"c"}, "c": set()}) == []
+
+
+def test_unity_lives_in_one_place():
+    shell = [p for p in _modules("cosim") if "unity" in p.stem]
+    assert shell == [], "Unity belongs to adapters/unity/"
+    assert {p.stem for p in _modules("adapters", "unity")} >= {"server", "poses", "inbound"}
 
 
 def test_the_rules_see_every_floor():

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from adapters.assignment.contract import ProtocolAgent
 from adapters.assignment.tables import DtaRecords
 from adapters.assignment.topics import ASSIGNMENT
-from adapters.naming import topic
+from adapters.navigation.topics import goal_topic
 from adapters.tasks.topics import CLAIMS, DONE, SERVICE_REQUESTS
 from cosim.core.adapter import RunContext
 from cosim.core.hosts import HostId
@@ -127,7 +127,7 @@ class Commitments:
         robot.goal_id += 1
         self._claim(run, robot, now)
         goal = NavGoal(now, robot.goal_id, task.x_m, task.y_m)
-        run.bus.publish(topic(robot.name, "nav/goal"), goal, self.hosts[robot.index])
+        run.bus.publish(goal_topic(robot.name), goal, self.hosts[robot.index])
 
     def _claim(self, run: RunContext, robot: RobotTasks, now_ns: int) -> None:
         claim = TaskClaim(now_ns, robot.epoch, robot.task, robot.name, robot.task_cost, "claim")
@@ -146,7 +146,7 @@ class Commitments:
     def _cancel(self, run: RunContext, robot: RobotTasks) -> None:
         robot.goal_id += 1
         cancel = NavGoal(run.kernel.now_ns, robot.goal_id, math.nan, math.nan)
-        run.bus.publish(topic(robot.name, "nav/goal"), cancel, self.hosts[robot.index])
+        run.bus.publish(goal_topic(robot.name), cancel, self.hosts[robot.index])
 
     def become_idle(self, robot: RobotTasks) -> None:
         """The robot holds no task any more."""

@@ -32,7 +32,8 @@ from adapters.assignment.contract import (
 from adapters.assignment.settings import AssignmentConfig
 from adapters.assignment.tables import ASSIGNMENTS, DtaRecords
 from adapters.assignment.topics import ASSIGNMENT
-from adapters.naming import topic
+from adapters.fleet.topics import odom_topic
+from adapters.navigation.topics import goal_topic, status_topic
 from adapters.network.contract import NetworkView
 from adapters.tasks.contract import CentralOrders
 from adapters.tasks.settings import TasksConfig
@@ -123,7 +124,7 @@ class DtaAdapter:
     def _advertise(self, run: RunContext) -> None:
         bus = run.bus
         for name in self.names:
-            bus.advertise(topic(name, "nav/goal"), NavGoal)
+            bus.advertise(goal_topic(name), NavGoal)
         bus.advertise(CLAIMS, TaskClaim)
         bus.advertise(SERVICE_REQUESTS, ServiceRequest)
         bus.advertise(DONE, TaskDone)
@@ -147,8 +148,8 @@ class DtaAdapter:
             bus.subscribe(reply_topic(robot.name), host, on)
             bus.subscribe(ack_topic(robot.name), host, on)
             bus.subscribe(order_topic(robot.name), host, on)
-            bus.subscribe(topic(robot.name, "nav/status"), host, on)
-            bus.subscribe(topic(robot.name, "odom"), host, on)
+            bus.subscribe(status_topic(robot.name), host, on)
+            bus.subscribe(odom_topic(robot.name), host, on)
         if self.cfg.round_phase == "aligned":
             run.kernel.every(self.period_ns, lambda now: self._round(run, now), stage=Stage.CONTROL)
         else:

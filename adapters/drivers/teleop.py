@@ -17,7 +17,8 @@ import math
 from collections.abc import Callable, Mapping
 from typing import Any, ClassVar
 
-from adapters.naming import topic
+from adapters.drivers.topics import teleop_topic
+from adapters.fleet.topics import cmd_vel_topic
 from cosim.core.adapter import RunContext
 from cosim.core.bus import Envelope
 from cosim.core.hosts import HostId
@@ -29,13 +30,6 @@ from models.fleet.kinematics import FleetState
 
 DEADMAN_S = 0.5
 """A robot with no command this long stops (s)."""
-TELEOP_LEAF = "teleop/cmd_vel"
-"""The topic leaf of an operator's commands, in each robot's namespace."""
-
-
-def teleop_topic(robot: str) -> str:
-    """The bus topic of the operator's commands to ``robot`` (``/robot_1/teleop/cmd_vel``)."""
-    return topic(robot, TELEOP_LEAF)
 
 
 class TeleopAdapter:
@@ -62,14 +56,14 @@ class TeleopAdapter:
         self.stops = 0
         self._following = [False] * count
         for name in self.names:
-            run.bus.advertise(topic(name, "cmd_vel"), Twist)
+            run.bus.advertise(cmd_vel_topic(name), Twist)
             run.bus.advertise(teleop_topic(name), Twist)
 
     def start(self, run: RunContext) -> None:
         """Subscribe to every robot's operator commands and start the control tick."""
         for index, (name, host) in enumerate(zip(self.names, self.hosts, strict=True)):
             run.bus.subscribe(teleop_topic(name), host, self._on_command(run, index))
-        self._cmd_topics = [topic(name, "cmd_vel") for name in self.names]
+        self._cmd_topics = [cmd_vel_topic(name) for name in self.names]
         run.kernel.every(self.period_ns, lambda now: self._control(run, now), stage=Stage.CONTROL)
 
     def _on_command(self, run: RunContext, index: int) -> Callable[[Message, Envelope], None]:

@@ -12,7 +12,8 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from adapters.naming import topic
+from adapters.fleet.topics import cmd_vel_topic
+from adapters.sensing.topics import scan_topic
 from cosim.core.adapter import RunContext
 from cosim.core.bus import Envelope
 from cosim.core.hosts import HostId
@@ -44,13 +45,13 @@ class WanderAdapter:
         self.angles: np.ndarray | None = None
         self.seen = np.zeros(len(self.names), dtype=bool)
         for name in self.names:
-            run.bus.advertise(topic(name, "cmd_vel"), Twist)
+            run.bus.advertise(cmd_vel_topic(name), Twist)
 
     def start(self, run: RunContext) -> None:
         """Subscribe to every robot's scan and start the control tick."""
         for index, (name, host) in enumerate(zip(self.names, self.hosts, strict=True)):
-            run.bus.subscribe(topic(name, "scan"), host, self._on_scan(index))
-        self._cmd_topics = [topic(name, "cmd_vel") for name in self.names]
+            run.bus.subscribe(scan_topic(name), host, self._on_scan(index))
+        self._cmd_topics = [cmd_vel_topic(name) for name in self.names]
         run.kernel.every(self.period_ns, lambda now: self._control(run), stage=Stage.CONTROL)
 
     def _on_scan(self, index: int) -> Callable[[Message, Envelope], None]:

@@ -18,7 +18,8 @@ import shapely
 from shapely.geometry import LineString, box
 from shapely.prepared import prep
 
-from adapters.naming import topic
+from adapters.drivers.topics import waypoint_topic
+from adapters.fleet.topics import cmd_vel_topic, odom_topic
 from cosim.core.adapter import RunContext
 from cosim.core.bus import Envelope
 from cosim.core.hosts import HostId
@@ -71,15 +72,15 @@ class WaypointsAdapter:
         self.reached = 0
         self.abandoned = 0
         for name in self.names:
-            run.bus.advertise(topic(name, "cmd_vel"), Twist)
-            run.bus.advertise(topic(name, "goal"), Goal)
+            run.bus.advertise(cmd_vel_topic(name), Twist)
+            run.bus.advertise(waypoint_topic(name), Goal)
 
     def start(self, run: RunContext) -> None:
         """Subscribe to odometry, issue first waypoints, start the control tick."""
         for index, (name, host) in enumerate(zip(self.names, self.hosts, strict=True)):
-            run.bus.subscribe(topic(name, "odom"), host, self._on_odom(index))
-        self._cmd_topics = [topic(name, "cmd_vel") for name in self.names]
-        self._goal_topics = [topic(name, "goal") for name in self.names]
+            run.bus.subscribe(odom_topic(name), host, self._on_odom(index))
+        self._cmd_topics = [cmd_vel_topic(name) for name in self.names]
+        self._goal_topics = [waypoint_topic(name) for name in self.names]
         for index in range(len(self.names)):
             self._new_goal(run, index)
         run.kernel.every(self.period_ns, lambda now: self._control(run, now), stage=Stage.CONTROL)

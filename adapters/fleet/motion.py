@@ -17,7 +17,8 @@ from typing import Any, ClassVar
 import numpy as np
 
 from adapters.fleet.mirror import Mirrors
-from adapters.naming import robot_name, topic
+from adapters.fleet.topics import cmd_vel_topic, odom_topic
+from adapters.naming import robot_name
 from cosim.core.adapter import RunContext
 from cosim.core.bus import Envelope
 from cosim.core.hosts import HostKind
@@ -77,7 +78,7 @@ class FleetAdapter:
         run.provide(self.mirrors)
         run.provide(self)
         for name in names:
-            run.bus.advertise(topic(name, "odom"), Odometry)
+            run.bus.advertise(odom_topic(name), Odometry)
 
     def add_guard(self, guard: MotionGuard) -> None:
         """Let ``guard`` inspect (and hold back) every proposed step before it is committed."""
@@ -86,8 +87,8 @@ class FleetAdapter:
     def start(self, run: RunContext) -> None:
         """Subscribe to every robot's cmd_vel and start the physics tick."""
         for index, (name, host) in enumerate(zip(self.state.names, self.hosts, strict=True)):
-            run.bus.subscribe(topic(name, "cmd_vel"), host, self._on_cmd(index))
-        self._odom_topics = [topic(name, "odom") for name in self.state.names]
+            run.bus.subscribe(cmd_vel_topic(name), host, self._on_cmd(index))
+        self._odom_topics = [odom_topic(name) for name in self.state.names]
         run.kernel.every(self.period_ns, lambda now: self._tick(run, now), stage=Stage.PHYSICS)
 
     def _on_cmd(self, index: int) -> Callable[[Message, Envelope], None]:

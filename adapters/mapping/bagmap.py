@@ -27,7 +27,8 @@ from adapters.mapping.recording import (
 from cosim.core.errors import BagError
 from models.geometry.se2 import compose, relative
 from models.mapping.grid import MAX_CELLS, LogOddsMap, MapGeometry
-from models.mapping.loops import LoopCloser, LoopParams
+from models.mapping.loop_params import LoopParams
+from models.mapping.loops import LoopCloser
 from models.mapping.matcher import MatcherParams
 from models.mapping.quality import align_se2, ate_rmse
 from models.mapping.slam import MapperParams, ScanMapper, UpdateGate

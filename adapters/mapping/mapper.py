@@ -23,12 +23,13 @@ from typing import Any, ClassVar
 import numpy as np
 
 from adapters.fleet.robots_layer import RobotsLayer
+from adapters.fleet.topics import odom_topic
 from adapters.mapping.contract import MAP_SHARING, MapSharing, SharingContext
 from adapters.mapping.geometry import map_geometry
 from adapters.mapping.settings import MappingConfig
 from adapters.mapping.tables import MAP_MERGES, MAP_QUALITY, SCAN_MATCHES, MappingRecords
 from adapters.mapping.topics import FLEET_MAP, correction_topic, map_topic
-from adapters.naming import topic
+from adapters.sensing.topics import scan_topic
 from cosim.core.adapter import RunContext
 from cosim.core.bus import Envelope, TopicQos
 from cosim.core.hosts import BASE_HOST, HostId
@@ -48,7 +49,7 @@ from models.arrays import FloatArray
 from models.fleet.kinematics import FleetState
 from models.geometry.occupancy import OccupancyGrid as Grid
 from models.mapping.grid import LogOddsMap, Scratch, merged
-from models.mapping.loops import LoopParams
+from models.mapping.loop_params import LoopParams
 from models.mapping.matcher import MatcherParams
 from models.mapping.slam import MapperParams, ScanMapper, UpdateGate
 from models.sensing.lidar import ScanGeometry
@@ -158,8 +159,8 @@ class MappingAdapter:
         if run.has_service(RobotsLayer):
             self.robots_layer = run.service(RobotsLayer)
         for i, (name, host) in enumerate(zip(self.names, self.hosts, strict=True)):
-            bus.subscribe(topic(name, "odom"), host, self._on_odom(i))
-            bus.subscribe(topic(name, "scan"), host, self._on_scan(run, i))
+            bus.subscribe(odom_topic(name), host, self._on_odom(i))
+            bus.subscribe(scan_topic(name), host, self._on_scan(run, i))
         kernel = run.kernel
         interval = period_ns(1.0 / self.cfg.map_update_interval_s)
         kernel.every(

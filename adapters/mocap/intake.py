@@ -24,7 +24,7 @@ import math
 from adapters.fleet.mirror import Mirrors
 from adapters.mocap.settings import MocapConfig
 from adapters.mocap.tables import MocapRecords
-from adapters.naming import topic
+from adapters.mocap.topics import pose_topic
 from cosim.core.adapter import RunContext
 from cosim.core.hosts import HostId
 from cosim.core.messages import PoseStamped
@@ -35,11 +35,6 @@ from models.mocap.gate import PoseGate
 
 JUMP_TOLERANCE_RAD = 0.2
 """Yaw change allowed beyond the yaw-rate limit between two poses (rad)."""
-
-
-def pose_topic(robot: str) -> str:
-    """The bus topic of the poses a robot localizes by."""
-    return topic(robot, "pose")
 
 
 class PoseIntake:

@@ -17,8 +17,8 @@ from typing import Any, ClassVar
 import numpy as np
 from scipy import ndimage
 
-from adapters.naming import topic
 from adapters.navigation.settings import NavigationConfig
+from adapters.navigation.topics import goal_topic, status_topic
 from cosim.core.adapter import RunContext
 from cosim.core.bus import Envelope
 from cosim.core.errors import ConfigError
@@ -72,12 +72,12 @@ class GoalsAdapter:
         self.next_id = np.zeros(len(self.names), dtype=np.int64)
         self.sent = 0
         for name in self.names:
-            run.bus.advertise(topic(name, "nav/goal"), NavGoal)
+            run.bus.advertise(goal_topic(name), NavGoal)
 
     def start(self, run: RunContext) -> None:
         """Listen to every robot's navigation status and send the first goals."""
         for i, (name, host) in enumerate(zip(self.names, self.hosts, strict=True)):
-            run.bus.subscribe(topic(name, "nav/status"), host, self._on_status(run, i))
+            run.bus.subscribe(status_topic(name), host, self._on_status(run, i))
         for i in range(len(self.names)):
             self._send(run, i)
 
@@ -119,7 +119,7 @@ class GoalsAdapter:
         goal = NavGoal(run.kernel.now_ns, int(self.next_id[i]), x, y)
         self.next_id[i] += 1
         self.sent += 1
-        run.bus.publish(topic(self.names[i], "nav/goal"), goal, self.hosts[i])
+        run.bus.publish(goal_topic(self.names[i]), goal, self.hosts[i])
 
     def finish(self, run: RunContext) -> Mapping[str, Any]:
         """Goals sent."""

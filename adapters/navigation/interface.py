@@ -13,10 +13,13 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from adapters.naming import topic
+from adapters.fleet.topics import cmd_vel_topic
+from adapters.mapping.topics import map_topic
 from adapters.navigation.goal_tracking import GoalTracker
 from adapters.navigation.layers import StaticLayers
 from adapters.navigation.scan_memory import ScanMemory
+from adapters.navigation.topics import goal_topic, plan_topic, status_topic
+from adapters.sensing.topics import scan_topic
 from cosim.core.adapter import RunContext
 from cosim.core.bus import Bus, Envelope
 from cosim.core.hosts import HostId
@@ -52,9 +55,9 @@ class NavInterface:
         return cls(
             names,
             hosts,
-            [topic(n, "nav/status") for n in names],
-            [topic(n, "cmd_vel") for n in names],
-            [topic(n, "plan") for n in names],
+            [status_topic(n) for n in names],
+            [cmd_vel_topic(n) for n in names],
+            [plan_topic(n) for n in names],
         )
 
     def advertise(self, bus: Bus) -> None:
@@ -89,10 +92,10 @@ class NavInterface:
         """
         bus = run.bus
         for i, (name, host) in enumerate(zip(self.names, self.hosts, strict=True)):
-            bus.subscribe(topic(name, "nav/goal"), host, _on_goal(run, goals, i))
-            bus.subscribe(topic(name, "scan"), host, _on_scan(memory, pose, i))
+            bus.subscribe(goal_topic(name), host, _on_goal(run, goals, i))
+            bus.subscribe(scan_topic(name), host, _on_scan(memory, pose, i))
             if mapping:
-                bus.subscribe(topic(name, "map"), host, _on_map(layers, i))
+                bus.subscribe(map_topic(name), host, _on_map(layers, i))
 
     def publish_commands(self, run: RunContext, v: FloatArray, w: FloatArray) -> None:
         """Every robot's command: speed ``v`` (m/s) and yaw rate ``w`` (rad/s), ``base_link``."""

@@ -18,11 +18,12 @@ from collections.abc import Callable
 import numpy as np
 import numpy.typing as npt
 
-from adapters.mocap.intake import pose_topic
+from adapters.fleet.topics import odom_topic
+from adapters.mapping.topics import correction_topic
 from adapters.mocap.settings import MocapConfig
 from adapters.mocap.tables import MocapRecords
+from adapters.mocap.topics import pose_topic
 from adapters.mocap.tracking import tracked_robots
-from adapters.naming import topic
 from cosim.core.adapter import RunContext
 from cosim.core.bus import Envelope
 from cosim.core.hosts import HostId
@@ -111,9 +112,9 @@ class Localization:
         """Subscribe every robot's software to its odometry, corrections and poses."""
         bus = run.bus
         for i, (name, host) in enumerate(zip(self.names, hosts, strict=True)):
-            bus.subscribe(topic(name, "odom"), host, self._on_odom(i))
+            bus.subscribe(odom_topic(name), host, self._on_odom(i))
             if self.mapping:
-                bus.subscribe(topic(name, "tf"), host, self._on_correction(i))
+                bus.subscribe(correction_topic(name), host, self._on_correction(i))
         self.measured.subscribe(run, hosts, self._on_measured_pose)
 
     def _on_measured_pose(self, i: int, x_m: float, y_m: float, yaw_rad: float) -> None:

@@ -31,15 +31,17 @@ from collections.abc import Callable, Mapping
 from typing import Any, ClassVar
 
 from adapters.fleet.mirror import Mirrors
+from adapters.fleet.topics import cmd_vel_topic, odom_topic
 from adapters.mocap.intake import PoseIntake
 from adapters.mocap.settings import MocapConfig
 from adapters.mocap.tracking import live_sources, source_of, tracked_bodies
-from adapters.naming import topic
+from adapters.navigation.topics import goal_pose_topic, goal_topic
 from adapters.physical.settings import PhysicalConfig
 from adapters.ros2dds import types as dds
 from adapters.ros2dds.participant import Publisher, Subscription
 from adapters.ros2dds.qos import QosKind
 from adapters.ros2dds.session import DdsSession, dds_session
+from adapters.sensing.topics import scan_topic
 from cosim.core.adapter import RunContext, ScenarioView
 from cosim.core.bus import Envelope
 from cosim.core.errors import BridgeError, ConfigError
@@ -139,24 +141,22 @@ class PhysicalAdapter:
         participant = self.session.participant
         for robot in self.robots:
             robot.scan = participant.publisher(
-                topic(robot.name, "scan"), dds.LaserScan, QosKind.SENSOR_DATA
+                scan_topic(robot.name), dds.LaserScan, QosKind.SENSOR_DATA
             )
-            run.bus.subscribe(topic(robot.name, "scan"), robot.host, self._on_scan(run, robot))
+            run.bus.subscribe(scan_topic(robot.name), robot.host, self._on_scan(run, robot))
             if self.cfg.drive == "cosim":
                 robot.command = participant.publisher(
-                    topic(robot.name, "cmd_vel"), dds.Twist, QosKind.DEFAULT
+                    cmd_vel_topic(robot.name), dds.Twist, QosKind.DEFAULT
                 )
-                run.bus.subscribe(topic(robot.name, "cmd_vel"), robot.host, self._on_cmd(robot))
+                run.bus.subscribe(cmd_vel_topic(robot.name), robot.host, self._on_cmd(robot))
             else:
                 robot.command = participant.publisher(
-                    topic(robot.name, "goal_pose"), dds.PoseStamped, QosKind.DEFAULT
+                    goal_pose_topic(robot.name), dds.PoseStamped, QosKind.DEFAULT
                 )
-                run.bus.subscribe(
-                    topic(robot.name, "nav/goal"), robot.host, self._on_goal(run, robot)
-                )
+                run.bus.subscribe(goal_topic(robot.name), robot.host, self._on_goal(run, robot))
             if self.intake is not None:
                 robot.odom = participant.subscription(
-                    topic(robot.name, "odom"), dds.Odometry, QosKind.SENSOR_DATA
+                    odom_topic(robot.name), dds.Odometry, QosKind.SENSOR_DATA
                 )
         if self.intake is not None:
             run.kernel.every(period_ns(self.cfg.poll_hz), self._poll, stage=Stage.SENSING)
@@ -271,13 +271,13 @@ class PhysicalAdapter:
         participant = self.session.participant
         for robot in self.robots:
             self.foreign += (
-                participant.foreign_writers(topic(robot.name, "cmd_vel"), "geometry_msgs/msg/Twist")
+                participant.foreign_writers(cmd_vel_topic(robot.name), "geometry_msgs/msg/Twist")
                 if self.cfg.drive == "cosim"
                 else 0
             )
             if robot.odom is not None:
                 self.foreign += participant.foreign_writers(
-                    topic(robot.name, "odom"), "nav_msgs/msg/Odometry"
+                    odom_topic(robot.name), "nav_msgs/msg/Odometry"
                 )
                 self.malformed += robot.odom.malformed
         self.session.close()

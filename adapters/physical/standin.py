@@ -27,6 +27,8 @@ from typing import NoReturn
 
 import numpy as np
 
+from adapters.fleet.topics import cmd_vel_topic, odom_topic
+from adapters.mocap.topics import pose_topic
 from adapters.ros2dds.naming import dds_topic
 from adapters.ros2dds.participant import RosParticipant
 from adapters.ros2dds.qos import QosKind
@@ -45,6 +47,7 @@ from adapters.ros2dds.types import (
     stamp,
     yaw_to_quaternion,
 )
+from adapters.sensing.topics import scan_topic
 from cosim.core.errors import ConfigError, CosimError
 from models.arrays import FloatArray
 from models.fleet.kinematics import DriveLimits, FleetState
@@ -205,10 +208,10 @@ def run_standin(
     pending: deque[tuple[int, PoseStamped]] = deque()
     poses = commands = scans = 0
     with RosParticipant(options.domain, interface=options.interface) as ros:
-        cmd_vel = ros.subscription(f"/{name}/cmd_vel", Twist, QosKind.DEFAULT)
-        scan = ros.subscription(f"/{name}/scan", LaserScan, QosKind.SENSOR_DATA)
-        pose_out = ros.publisher(f"/{name}/pose", PoseStamped, QosKind.SENSOR_DATA)
-        odom_out = ros.publisher(f"/{name}/odom", Odometry, QosKind.SENSOR_DATA)
+        cmd_vel = ros.subscription(cmd_vel_topic(name), Twist, QosKind.DEFAULT)
+        scan = ros.subscription(scan_topic(name), LaserScan, QosKind.SENSOR_DATA)
+        pose_out = ros.publisher(pose_topic(name), PoseStamped, QosKind.SENSOR_DATA)
+        odom_out = ros.publisher(odom_topic(name), Odometry, QosKind.SENSOR_DATA)
         where = options.interface or "loopback"
         say(f"{name}: on DDS domain {options.domain} ({where}), {options.rate_hz:g} Hz")
         start = last_ns = time.monotonic_ns()

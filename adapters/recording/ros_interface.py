@@ -33,8 +33,8 @@ import numpy as np
 
 from adapters.fleet.motion import FleetAdapter
 from adapters.humans.crowd import People
-from adapters.naming import topic
 from adapters.recording.poses import PosesAdapter
+from adapters.recording.topics import CLOCK, MAP, MARKERS, TF, TF_STATIC, ground_truth_topic
 from adapters.tasks.topics import TASKS
 from cosim.core.adapter import RunContext
 from cosim.core.bus import TopicQos
@@ -68,11 +68,6 @@ WALL_HEIGHT_M = 2.0
 ROBOT_HEIGHT_M = 0.25
 """Jackal's body height, about 0.25 m (Clearpath's datasheet)."""
 
-CLOCK = "/clock"
-TF = "/tf"
-TF_STATIC = "/tf_static"
-MAP = "/map"
-MARKERS = "/world/markers"
 HUMAN_MARKERS = "/humans/markers"
 PERSON_RGBA: RGBA = (0.95, 0.56, 0.17, 0.9)
 FORKLIFT_RGBA: RGBA = (0.93, 0.79, 0.28, 0.9)
@@ -91,7 +86,7 @@ class RosInterfaceAdapter:
         self.fleet = run.service(FleetState)
         self.motion = run.service(FleetAdapter)
         self.names = list(self.fleet.names)
-        self.truth_topics = [topic(n, "ground_truth") for n in self.names]
+        self.truth_topics = [ground_truth_topic(n) for n in self.names]
         self.frames = [(f"{n}/odom", f"{n}/base_link") for n in self.names]
         self.radius_m = run.settings(RobotsConfig).radius_m
         self.static_markers = self._static_markers()

@@ -14,7 +14,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from adapters.naming import topic
+from adapters.sensing.topics import scan_topic
 from cosim.core.adapter import RunContext
 from cosim.core.bus import TopicQos
 from cosim.core.hosts import HostId
@@ -66,7 +66,7 @@ class LidarAdapter:
         )
         self._zeros = np.zeros((len(names), beams), dtype=np.float32)
         self._ones = np.ones((len(names), beams), dtype=np.float32)
-        self.topics = [topic(name, "scan") for name in self.fleet.names]
+        self.topics = [scan_topic(name) for name in self.fleet.names]
         self._own = np.arange(len(names), dtype=np.int64)  # each robot's own circle
         self._frames = [f"{name}/laser" for name in names]
         self._hosts = [HostId(name) for name in names]

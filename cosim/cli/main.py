@@ -114,9 +114,9 @@ def _cmd_run(args: argparse.Namespace) -> int:
 def _run_and_report(args: argparse.Namespace, stop: StopRequest, ran: list[Path]) -> int:
     from adapters.physical.domain import claim_run_domain
     from adapters.physical.launcher import Standins
+    from adapters.unity.server import UnityOptions
     from cosim.cli.hostname import check_live_host
     from cosim.recording.foxglove import LiveOptions
-    from cosim.recording.unity import UnityOptions
     from cosim.runner.execute import run
     from cosim.runner.stopping import RunStopped
 

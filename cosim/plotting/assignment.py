@@ -18,10 +18,10 @@ import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 
+from adapters.tasks.topics import TASKS
 from cosim.plotting.canvas import save_png
 from cosim.plotting.rundata import RunData
 
-ANNOUNCEMENTS = "/fleet/tasks"
 """Topic of the task source's task sets (adapters.assignment.topics.TASKS)."""
 DECIDED = "#1f77b4"
 SUPERSEDED = "0.75"
@@ -148,7 +148,7 @@ def _announcements(run: RunData) -> pd.DataFrame | None:
     messages = run.messages
     if messages is None:
         return None
-    copies = messages[(messages["topic"] == ANNOUNCEMENTS) & (messages["status"] == "delivered")]
+    copies = messages[(messages["topic"] == TASKS) & (messages["status"] == "delivered")]
     if copies.empty:
         return None
     return copies[["dst_host", "t_recv_s", "t_sent_s"]].sort_values("t_recv_s")

@@ -13,13 +13,13 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from adapters.unity.server import UnityOptions, UnitySink
 from cosim.core.bus import Advertisement, Bus
 from cosim.recording.bag import BAG_DIR, BagSink
 from cosim.recording.foxglove import LiveOptions, LiveSink
 from cosim.recording.schemas import channel_specs
 from cosim.recording.selection import select_topics
 from cosim.recording.tap import RecordingTap, Sink
-from cosim.recording.unity import UnityOptions, UnitySink
 from cosim.scenario.model import Scenario
 
 

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from adapters.unity.server import UnityOptions
 from cosim.core.adapter import AdapterType
 from cosim.core.errors import BridgeError, RegistryError
 from cosim.core.kernel import Lateness
@@ -22,7 +23,6 @@ from cosim.core.timebase import NS_PER_S, s_to_ns
 from cosim.recording.dataframes import run_frames
 from cosim.recording.foxglove import LiveOptions
 from cosim.recording.setup import RecordingPlan, RecordingSession
-from cosim.recording.unity import UnityOptions
 from cosim.runner.assembly import Assembly, assemble
 from cosim.runner.compiletime import CompileClock
 from cosim.runner.outfolder import prepare_out, write_run
@@ -336,7 +336,7 @@ def run(
         progress: called with (sim s, duration s, wall s) during the run.
         live: serve the run live to Foxglove (see :class:`cosim.recording.foxglove.LiveOptions`).
         unity: serve the run to Unity's ROS-TCP-Connector scenes (see
-            :class:`cosim.recording.unity.UnityOptions`), paced in real time.
+            :class:`adapters.unity.server.UnityOptions`), paced in real time.
         on_ready: called once the recording is set up, before the run starts.
         adapters: more adapters to run: registered names, or adapter classes (a class is
             used for this run as if registered under its ``name``; the resolved

@@ -31,7 +31,7 @@ from models.mapping.posegraph import Edge
 from models.mapping.update_graph import UpdateGraph, in_frame
 
 if TYPE_CHECKING:
-    from models.mapping.loops import LoopParams
+    from models.mapping.loop_params import LoopParams
 
 
 class ClosureChecks:

@@ -25,7 +25,7 @@ from models.mapping.uncertainty import match_covariance
 from models.mapping.update_graph import UpdateGraph
 
 if TYPE_CHECKING:
-    from models.mapping.loops import LoopParams
+    from models.mapping.loop_params import LoopParams
 
 
 class LoopSearch:

@@ -23,7 +23,8 @@ from models.arrays import FloatArray
 from models.errors import ModelError
 from models.geometry.se2 import Pose, compose, inverse, relative
 from models.mapping.grid import LogOddsMap
-from models.mapping.loops import LoopCloser, LoopParams
+from models.mapping.loop_params import LoopParams
+from models.mapping.loops import LoopCloser
 from models.mapping.matcher import MatcherParams, match, scan_points
 from models.mapping.uncertainty import match_covariance
 

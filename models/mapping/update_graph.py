@@ -25,7 +25,7 @@ from models.geometry.se2 import Pose, relative
 from models.mapping.posegraph import Edge, PoseGraph, sqrt_information
 
 if TYPE_CHECKING:
-    from models.mapping.loops import LoopParams
+    from models.mapping.loop_params import LoopParams
 
 
 @dataclass

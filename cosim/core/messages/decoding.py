@@ -5,7 +5,8 @@ integer ns; a string to ``str``; a numeric sequence to a NumPy array, a byte seq
 ``bytes``; a sequence of structs to a list. Bytes come from the network, a bag or a Unity
 scene and are not trusted: whatever does not hold a message of the type (a wrong
 encapsulation, too few bytes, a string without its NUL or not UTF-8, a count beyond the
-bytes) is refused with :class:`~cosim.core.errors.WireError`, naming the type and the byte.
+bytes, more than 3 bytes left over after it) is refused with
+:class:`~cosim.core.errors.WireError`, naming the type and the byte.
 """
 
 from __future__ import annotations
@@ -112,4 +113,10 @@ def decode_tree(kind: Struct, data: bytes | bytearray | memoryview) -> tuple[Any
         tree = reader.value(kind)
     except WireError as error:
         raise WireError(f"{kind.ros_type}: {error}") from None
+    left = reader.end - reader.at
+    if left > 3:  # a message may end in up to 3 bytes of padding, not more
+        raise WireError(
+            f"{kind.ros_type}: {left} bytes left over after the message at byte {reader.at} "
+            f"of {reader.end}; expected its end"
+        )
     return tree  # type: ignore[no-any-return]

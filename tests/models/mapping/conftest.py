@@ -10,7 +10,7 @@ import pytest
 
 from models.geometry.se2 import compose, relative
 from models.mapping.grid import LogOddsMap, MapGeometry
-from models.mapping.loops import LoopParams
+from models.mapping.loop_params import LoopParams
 from models.mapping.posegraph import Edge, sqrt_information
 from models.mapping.update_graph import UpdateGraph
 from models.sensing.lidar import ScanGeometry

@@ -3,7 +3,7 @@
 import numpy as np
 
 from models.mapping.closure_checks import ClosureChecks
-from models.mapping.loops import LoopParams
+from models.mapping.loop_params import LoopParams
 from tests.models.mapping.conftest import closure, out_and_back
 
 

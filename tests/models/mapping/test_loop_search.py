@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from models.geometry.se2 import compose
+from models.mapping.loop_params import LoopParams
 from models.mapping.loop_search import LoopSearch
-from models.mapping.loops import LoopParams
 from models.mapping.posegraph import Edge
 from models.mapping.update_graph import UpdateGraph
 from tests.models.mapping.conftest import LAP, ROOM, Lidar, integrate, room_map

@@ -11,7 +11,8 @@ import numpy as np
 
 from models.geometry.se2 import compose
 from models.mapping.grid import LogOddsMap
-from models.mapping.loops import LoopCloser, LoopParams
+from models.mapping.loop_params import LoopParams
+from models.mapping.loops import LoopCloser
 from tests.models.mapping.conftest import LAP, MATCHED, ROOM, Lidar, integrate, room_map
 
 LIDAR = Lidar(ROOM)

@@ -5,7 +5,7 @@ import pytest
 
 from models.geometry.se2 import compose, inverse, relative
 from models.mapping.grid import LogOddsMap, MapGeometry
-from models.mapping.loops import LoopParams
+from models.mapping.loop_params import LoopParams
 from models.mapping.slam import MapperParams, ScanMapper, UpdateGate
 from tests.models.mapping.conftest import GEOMETRY, Lidar
 

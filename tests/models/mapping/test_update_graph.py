@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from models.mapping.loops import LoopParams
+from models.mapping.loop_params import LoopParams
 from models.mapping.update_graph import UpdateGraph, in_frame
 from tests.models.mapping.conftest import MATCHED, closure, out_and_back
 

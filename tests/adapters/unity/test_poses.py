@@ -8,10 +8,10 @@ import math
 import pytest
 
 import cosim
+from adapters.unity.server import UnityOptions, UnitySink
 from cosim.core.errors import ConfigError
 from cosim.core.timebase import s_to_ns
 from cosim.recording.schemas import channel_specs
-from cosim.recording.unity import UnityOptions, UnitySink
 from cosim.runner.assembly import assemble
 from models.fleet.kinematics import FleetState
 from tests.cosim.recording.connector import Connector, goal_pose_cdr

@@ -14,14 +14,14 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from adapters.unity.inbound import UnityGoal
+from adapters.unity.server import UnityOptions, UnitySink
 from cosim.core.bus import Bus, TopicQos
 from cosim.core.errors import BridgeError
 from cosim.core.hosts import HostId
 from cosim.core.kernel import Kernel
 from cosim.core.messages import LaserScan, Message, NavGoal
 from cosim.recording.schemas import channel_specs, typestore
-from cosim.recording.unity import UnityOptions, UnitySink
-from cosim.recording.unity.inbound import UnityGoal
 from tests.cosim.recording.connector import Connector, connector_string, goal_pose_cdr
 
 

@@ -7,12 +7,19 @@ counts as a rejected frame. Nothing a scene sends can end the run.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+import queue
+from collections.abc import Mapping, Sequence
+from typing import Protocol
 
-from cosim.recording.unity import frames
-from cosim.recording.unity.inbound import (
+from adapters.fleet.topics import cmd_vel_topic
+from adapters.navigation.topics import goal_pose_topic
+from adapters.unity import framing as frames
+from adapters.unity.inbound import (
     GOAL_TYPE,
     TWIST_TYPE,
+    UnityGoal,
+    UnityPose,
+    UnityTwist,
     decode_goal,
     decode_pose,
     decode_twist,
@@ -20,14 +27,66 @@ from cosim.recording.unity.inbound import (
     unity_name,
 )
 
-if TYPE_CHECKING:
-    from cosim.recording.unity.server import _Client
+
+class Served(Protocol):
+    """A topic the endpoint serves."""
+
+    @property
+    def topic(self) -> str:
+        """The topic."""
+        ...
+
+    @property
+    def msgtype(self) -> str:
+        """Its ROS 2 type, ``pkg/msg/Type``."""
+        ...
+
+
+class Endpoint(Protocol):
+    """What the frames of a connection act on (:class:`~adapters.unity.server.UnitySink`)."""
+
+    channels: Sequence[Served]
+    by_topic: Mapping[str, int]
+    goal_topics: Mapping[str, str]
+    teleop_topics: Mapping[str, str]
+    pose_topics: Mapping[str, str]
+    goals: queue.SimpleQueue[UnityGoal]
+    twists: queue.SimpleQueue[UnityTwist]
+
+    def latched(self, topic: str) -> list[bytes]:
+        """The last frame of each publisher of a latched topic."""
+        ...
+
+    def topic_list(self) -> dict[str, list[str]]:
+        """``__topic_list``'s answer."""
+        ...
+
+    def take_pose(self, pose: UnityPose) -> None:
+        """Keep a tracked pose for the run."""
+        ...
+
+
+class Peer(Protocol):
+    """One connection, as its frames act on it (:class:`~adapters.unity.connection.Connection`)."""
+
+    sink: Endpoint
+    subscriptions: frozenset[str]
+    publishes: dict[str, str]
+
+    def send(self, data: bytes) -> None:
+        """Queue a frame to the scene."""
+        ...
+
+    def read_next(self) -> bytes:
+        """The payload of the next frame."""
+        ...
+
 
 _IGNORED = frozenset({"__remove_ros_service", "__remove_unity_service"})
 """Commands about registrations cosim never makes: nothing to undo."""
 
 
-def handle(client: _Client, destination: str, payload: bytes) -> None:
+def handle(client: Peer, destination: str, payload: bytes) -> None:
     """Act on one frame from Unity.
 
     Raises:
@@ -84,7 +143,7 @@ def handle(client: _Client, destination: str, payload: bytes) -> None:
         raise ValueError(f"unknown command {destination!r}; expected ROS-TCP-Connector 0.7's")
 
 
-def _publishable(client: _Client, topic: str, name: str) -> str:
+def _publishable(client: Peer, topic: str, name: str) -> str:
     """The robot a ``__publish`` of ``topic`` with type ``name`` steers (a pose: its bus topic).
 
     Raises:
@@ -97,15 +156,16 @@ def _publishable(client: _Client, topic: str, name: str) -> str:
     if robot is None:
         robot, msgtype = sink.pose_topics.get(topic), GOAL_TYPE
     if robot is None:
-        if topic.endswith("/cmd_vel") and topic.count("/") == 2:
+        robot_named = topic.split("/")[1] if topic.count("/") == 2 else ""
+        if robot_named and cmd_vel_topic(robot_named) == topic:
             raise ValueError(
-                f"__publish: {topic}: {topic.split('/')[1]!r} takes no velocity commands; "
+                f"__publish: {topic}: {robot_named!r} takes no velocity commands; "
                 'expected a robot whose driver allows teleoperation (robots.driver = "teleop")'
             )
         takes = ", ".join([*sink.goal_topics, *sink.teleop_topics, *sink.pose_topics])
         raise ValueError(
             f"__publish: cosim takes no {topic!r} from Unity; expected a goal "
-            f"/<robot>/goal_pose, a teleop /<robot>/cmd_vel or a tracked pose "
+            f"{goal_pose_topic('<robot>')}, a teleop {cmd_vel_topic('<robot>')} or a tracked pose "
             f"({takes or 'this run takes none'})"
         )
     if not same_type(name, msgtype):
@@ -113,7 +173,7 @@ def _publishable(client: _Client, topic: str, name: str) -> str:
     return robot
 
 
-def _publication(client: _Client, topic: str, payload: bytes) -> None:
+def _publication(client: Peer, topic: str, payload: bytes) -> None:
     """A goal, a velocity command or a tracked pose this connection registered."""
     robot = client.publishes.get(topic)
     if robot is None:

@@ -1,12 +1,13 @@
-"""The Unity sink: a ROS-TCP-Endpoint served by the run itself, for ROS-TCP-Connector scenes.
+"""The Unity endpoint: a ROS-TCP-Endpoint served by the run itself, for ROS-TCP-Connector scenes.
 
 Unity connects as the TCP client (the Connector's ROS IP and port). Each connection is its
-own session: its handshake first, then the topics it subscribed to, with the bytes the bag
-records; what it registered dies with it, as the Connector re-registers everything when it
-reconnects. A writer thread per connection sends, and sends a keepalive after a second
-without anything, so the Connector never takes an idle run for a lost one. Goals a scene
-publishes are queued by the connection's reader thread and published on the run's bus
-by the kernel (every :data:`DRAIN_EVERY_NS`): only the kernel's thread touches the run.
+own session (:mod:`adapters.unity.connection`): its handshake first, then the topics it
+subscribed to, with the bytes the bag records; what it registered dies with it, as the
+Connector re-registers everything when it reconnects. The endpoint is a sink of the run's
+recording (its ``open``, ``write`` and ``close`` take the recorded topics and messages).
+Goals a scene publishes are queued by the connection's reader thread and published on the
+run's bus by the kernel (every :data:`DRAIN_EVERY_NS`): only the kernel's thread touches
+the run.
 """
 
 from __future__ import annotations
@@ -18,16 +19,14 @@ import socket
 import threading
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Protocol
 
-from cosim.core.bus import Bus, TopicQos
-from cosim.core.errors import BridgeError
-from cosim.core.hosts import HostId
-from cosim.core.kernel import Stage
-from cosim.core.messages import NavGoal, PoseStamped, Twist
-from cosim.recording.schemas import ChannelSpec
-from cosim.recording.unity import frames
-from cosim.recording.unity.commands import handle
-from cosim.recording.unity.inbound import (
+from adapters.drivers.topics import teleop_topic
+from adapters.navigation.topics import goal_topic
+from adapters.unity import framing as frames
+from adapters.unity.commands import handle
+from adapters.unity.connection import Connection
+from adapters.unity.inbound import (
     GOAL_TYPE,
     TWIST_TYPE,
     UnityGoal,
@@ -35,17 +34,17 @@ from cosim.recording.unity.inbound import (
     UnityTwist,
     goal_topics,
     pose_topics,
-    teleop_bus_topic,
     teleop_topics,
     unity_name,
 )
+from cosim.core.bus import Bus, TopicQos
+from cosim.core.errors import BridgeError
+from cosim.core.hosts import HostId
+from cosim.core.kernel import Stage
+from cosim.core.messages import NavGoal, PoseStamped, Twist
 
 DRAIN_EVERY_NS = 50_000_000
 """Goals from Unity enter the run at most 50 ms (simulated) after they arrived."""
-KEEPALIVE_S = 1.0
-"""A connection idle this long (wall-clock s) gets a keepalive."""
-QUEUE_FRAMES = 10_000
-"""Frames waiting for a slow connection; more are dropped (and counted)."""
 GOAL_IDS = 2**31
 """Goal ids from Unity start here, apart from the run's own goal senders' ids."""
 COUNTS = ("unity_clients", "unity_frames_received", "unity_frames_rejected", "unity_goals")
@@ -54,6 +53,25 @@ COUNTS = ("unity_clients", "unity_frames_received", "unity_frames_rejected", "un
 run takes them)."""
 MOCAP_HOST = HostId("mocap")
 """The host tracked poses from Unity are published from (the mocap adapter's)."""
+
+
+class Channel(Protocol):
+    """A recorded topic as the endpoint serves it (the recording's ``ChannelSpec``)."""
+
+    @property
+    def topic(self) -> str:
+        """The topic."""
+        ...
+
+    @property
+    def msgtype(self) -> str:
+        """Its ROS 2 type, ``pkg/msg/Type``."""
+        ...
+
+    @property
+    def qos(self) -> TopicQos:
+        """How it is offered (a latched topic's last message goes to late subscribers)."""
+        ...
 
 
 @dataclass(frozen=True, slots=True)
@@ -80,7 +98,7 @@ class UnitySink:
     def __init__(self, options: UnityOptions, bus: Bus) -> None:
         self.options = options
         self.bus = bus
-        self.channels: list[ChannelSpec] = []
+        self.channels: list[Channel] = []
         self.by_topic: dict[str, int] = {}
         self.goal_topics: dict[str, str] = {}
         self.goals: queue.SimpleQueue[UnityGoal] = queue.SimpleQueue()
@@ -94,7 +112,7 @@ class UnitySink:
         )
         self.connected = threading.Event()
         self._latched: dict[int, dict[str, bytes]] = {}
-        self._clients: list[_Client] = []
+        self._clients: list[Connection] = []
         self._lock = threading.Lock()
         self._server: socket.socket | None = None
         self._accepting: threading.Thread | None = None
@@ -108,7 +126,7 @@ class UnitySink:
             raise BridgeError("unity: the server is not started")
         return int(self._server.getsockname()[1])
 
-    def open(self, channels: Sequence[ChannelSpec]) -> None:
+    def open(self, channels: Sequence[Channel]) -> None:
         """Listen, and have the kernel take Unity's goals into the run.
 
         Raises:
@@ -154,7 +172,7 @@ class UnitySink:
             except OSError:
                 return
             conn.settimeout(None)
-            client = _Client(self, conn)
+            client = Connection(self, conn, handle)
             with self._lock:
                 self._clients.append(client)
                 self.counts["unity_clients"] += 1
@@ -204,7 +222,7 @@ class UnitySink:
             except queue.Empty:
                 break
             command = Twist(twist.linear_x_mps, twist.angular_z_radps)
-            self.bus.publish(teleop_bus_topic(twist.robot), command, HostId(twist.robot))
+            self.bus.publish(teleop_topic(twist.robot), command, HostId(twist.robot))
             self.count("unity_twists")
         with self._lock:
             poses, self._poses = list(self._poses.values()), {}
@@ -218,7 +236,7 @@ class UnitySink:
             except queue.Empty:
                 return
             message = NavGoal(now_ns, next(self._goal_ids), goal.x_m, goal.y_m, goal.yaw_rad)
-            self.bus.publish(f"/{goal.robot}/nav/goal", message, HostId(goal.robot))
+            self.bus.publish(goal_topic(goal.robot), message, HostId(goal.robot))
             self.count("unity_goals")
 
     def summary(self) -> dict[str, int]:
@@ -249,102 +267,3 @@ class UnitySink:
             client.stop()
         for client in clients:
             client.join()
-
-
-class _Client:
-    """One connection: its subscriptions, its registered goal topics, its two threads."""
-
-    def __init__(self, sink: UnitySink, conn: socket.socket) -> None:
-        self.sink = sink
-        self.conn = conn
-        self.subscriptions: frozenset[str] = frozenset()
-        self.publishes: dict[str, str] = {}
-        self.outbox: queue.Queue[bytes | None] = queue.Queue(QUEUE_FRAMES)
-        self.outbox.put(frames.handshake())  # before anything else can be queued
-        self.closed = threading.Event()
-        self.threads = [
-            threading.Thread(target=self._send_loop, name="unity-send", daemon=True),
-            threading.Thread(target=self._read_loop, name="unity-read", daemon=True),
-        ]
-
-    def start(self) -> None:
-        for thread in self.threads:
-            thread.start()
-
-    def send(self, data: bytes) -> None:
-        """Queue a frame; a connection too slow to take it loses it (counted)."""
-        if self.closed.is_set():
-            return
-        try:
-            self.outbox.put_nowait(data)
-        except queue.Full:
-            self.sink.count("unity_frames_dropped")
-
-    def _send_loop(self) -> None:
-        try:
-            while not self.closed.is_set():
-                try:
-                    item = self.outbox.get(timeout=KEEPALIVE_S)
-                except queue.Empty:
-                    item = frames.KEEPALIVE
-                if item is None:
-                    return
-                self.conn.sendall(item)
-        except OSError:
-            pass
-        finally:
-            self.stop()
-
-    def _read_loop(self) -> None:
-        try:
-            while not self.closed.is_set():
-                got = frames.read_frame(self.conn)
-                if got is None:
-                    return
-                self.sink.count("unity_frames_received")
-                self._handle(*got)
-        except frames.FrameError as problem:  # the stream is lost: the Connector reconnects
-            self.sink.count("unity_frames_rejected")
-            self.send(frames.error(f"cosim: {problem}; closing the connection"))
-        except OSError:
-            pass
-        finally:
-            self._end_after_sending()
-
-    def _end_after_sending(self) -> None:
-        """Unity is gone or lost: send what is queued (an ``__error``), then end."""
-        try:
-            self.outbox.put(None, timeout=KEEPALIVE_S)
-        except queue.Full:
-            self.stop()
-
-    def _handle(self, destination: str, payload: bytes) -> None:
-        try:
-            handle(self, destination, payload)
-        except ValueError as problem:
-            self.sink.count("unity_frames_rejected")
-            self.send(frames.error(f"cosim: {problem}"))
-
-    def read_next(self) -> bytes:
-        """The payload of the frame after ``__request``/``__response``."""
-        got = frames.read_frame(self.conn)
-        if got is None:
-            raise frames.FrameError("connection closed before a service payload")
-        self.sink.count("unity_frames_received")
-        return got[1]
-
-    def stop(self) -> None:
-        """End the connection (from any thread; once)."""
-        if self.closed.is_set():
-            return
-        self.closed.set()
-        with contextlib.suppress(queue.Full):
-            self.outbox.put_nowait(None)
-        with contextlib.suppress(OSError):
-            self.conn.shutdown(socket.SHUT_RDWR)
-
-    def join(self) -> None:
-        for thread in self.threads:
-            if thread is not threading.current_thread():
-                thread.join(timeout=2.0)
-        self.conn.close()

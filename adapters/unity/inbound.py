@@ -3,8 +3,9 @@
 A ``geometry_msgs/PoseStamped`` on ``/<robot>/goal_pose`` (in ``map``, as RViz's 2D Goal
 Pose and Nav2 take it) becomes that robot's :class:`~cosim.core.messages.NavGoal`,
 published on ``/<robot>/nav/goal`` as the run's own goal senders do. The bytes are
-decoded by rosbags as a DDS sample would be: anything that does not decode, is not in
-``map`` or is not finite is refused, never evaluated.
+decoded as the declared ``geometry_msgs/PoseStamped`` (:mod:`cosim.core.messages.std`):
+anything that does not decode, is not in ``map`` or is not finite is refused, never
+evaluated.
 
 A ``geometry_msgs/Twist`` on ``/<robot>/cmd_vel`` (``base_link``: linear.x forward m/s,
 angular.z rad/s) drives a robot whose driver takes an operator's commands (``robots.driver
@@ -12,10 +13,10 @@ angular.z rad/s) drives a robot whose driver takes an operator's commands (``rob
 driver clips it to the robot's limits and stops the robot when commands stop.
 
 A ``geometry_msgs/PoseStamped`` (``map``) on a tracked robot's body topic serves as its
-motion capture (``mocap.source = "unity"``): the mocap adapter advertises the bus topic
-:data:`POSE_PREFIX` + the body topic (``/unity/robot_1/pose``; ``adapters.mocap.unity``
-spells the prefix the same), and the checked poses are published there from the ``mocap``
-host for its pose intake.
+motion capture (``mocap.source = "unity"``): the pose source
+(:mod:`adapters.unity.poses`) advertises the bus topic of each body
+(:func:`~adapters.unity.topics.pose_bus_topic`, ``/unity/robot_1/pose``), and the checked
+poses are published there from the ``mocap`` host for its pose intake.
 """
 
 from __future__ import annotations
@@ -25,20 +26,22 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from adapters.drivers.topics import teleop_topic
+from adapters.fleet.topics import cmd_vel_topic
+from adapters.navigation.topics import goal_pose_topic, goal_topic
+from adapters.unity.topics import POSE_PREFIX
 from cosim.core.bus import Advertisement
-from cosim.core.messages import NavGoal, PoseStamped, Twist
-from cosim.recording.schemas import typestore
+from cosim.core.errors import WireError
+from cosim.core.messages import NavGoal, PoseStamped, Twist, std
+from cosim.core.messages.decoding import decode_tree
+from cosim.core.messages.wire import Struct
 
-GOAL_TYPE = "geometry_msgs/msg/PoseStamped"
+GOAL_TYPE = std.POSE_STAMPED.ros_type
 """The ROS 2 type of a goal pose."""
 GOAL_FRAME = "map"
 """The frame a goal pose must be given in."""
-_GOAL_LEAF = "/nav/goal"
-TWIST_TYPE = "geometry_msgs/msg/Twist"
+TWIST_TYPE = std.TWIST.ros_type
 """The ROS 2 type of a velocity command."""
-_TELEOP_LEAF = "/teleop/cmd_vel"
-POSE_PREFIX = "/unity"
-"""Bus topics of tracked poses from Unity: this prefix, then the topic a scene publishes on."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -71,9 +74,9 @@ def goal_topics(advertised: Mapping[str, Advertisement]) -> dict[str, str]:
     """``/<robot>/goal_pose`` -> robot, for every robot whose navigation takes goals."""
     topics = {}
     for name, ad in advertised.items():
-        if ad.message_type is NavGoal and name.endswith(_GOAL_LEAF) and name.count("/") == 3:
-            robot = name[1 : -len(_GOAL_LEAF)]
-            topics[f"/{robot}/goal_pose"] = robot
+        robot = _robot_of(name, goal_topic)
+        if ad.message_type is NavGoal and robot:
+            topics[goal_pose_topic(robot)] = robot
     return topics
 
 
@@ -84,23 +87,20 @@ def decode_goal(robot: str, data: bytes) -> UnityGoal:
         ValueError: naming what is wrong (bytes that do not decode, another frame, a
             position that is not finite).
     """
-    x, y, yaw = _planar_pose(f"/{robot}/goal_pose", data)
+    x, y, yaw = _planar_pose(goal_pose_topic(robot), data)
     return UnityGoal(robot, x, y, yaw)
 
 
-def _decode(topic: str, data: bytes, msgtype: str) -> Any:
-    """A scene's CDR bytes as a ``msgtype`` message (rosbags' typestore), nothing evaluated.
+def _decode(topic: str, data: bytes, kind: Struct) -> Any:
+    """A scene's CDR bytes as the fields of a ``kind`` message (nested tuples).
 
     Raises:
-        ValueError: naming ``topic``, the byte count and rosbags' reason.
+        ValueError: naming ``topic``, the byte count and what did not decode.
     """
     try:
-        return typestore().deserialize_cdr(data, msgtype)
-    except Exception as problem:  # rosbags raises several kinds on bytes it cannot follow
-        raise ValueError(
-            f"{topic}: {len(data)} bytes are not a CDR {msgtype} "
-            f"({type(problem).__name__}: {problem})"
-        ) from None
+        return decode_tree(kind, data)
+    except WireError as problem:
+        raise ValueError(f"{topic}: {len(data)} bytes are not a CDR {problem}") from None
 
 
 def _planar_pose(topic: str, data: bytes) -> tuple[float, float, float]:
@@ -109,15 +109,12 @@ def _planar_pose(topic: str, data: bytes) -> tuple[float, float, float]:
     Raises:
         ValueError: naming ``topic`` and what is wrong.
     """
-    message = _decode(topic, data, GOAL_TYPE)
-    frame_id = message.header.frame_id
+    (_stamp, frame_id), ((x, y, _z), q) = _decode(topic, data, std.POSE_STAMPED)
     if frame_id != GOAL_FRAME:
         raise ValueError(f"{topic}: header.frame_id is {frame_id!r}; expected {GOAL_FRAME!r}")
-    position, q = message.pose.position, message.pose.orientation
-    x, y = float(position.x), float(position.y)
     if not (math.isfinite(x) and math.isfinite(y)):
         raise ValueError(f"{topic}: position ({x}, {y}); expected finite metres")
-    quaternion = (float(q.x), float(q.y), float(q.z), float(q.w))
+    quaternion = tuple(float(c) for c in q)
     if not all(math.isfinite(c) for c in quaternion):
         raise ValueError(f"{topic}: orientation {quaternion}; expected finite")
     qx, qy, qz, qw = quaternion
@@ -144,26 +141,22 @@ class UnityTwist:
     angular_z_radps: float
 
 
-def _robot_of(name: str, leaf: str) -> str | None:
-    """``robot`` of ``/<robot><leaf>``, or None."""
-    if name.endswith(leaf) and name.count("/") == 1 + leaf.count("/"):
-        return name[1 : -len(leaf)]
-    return None
+def _robot_of(name: str, topic_of: Any) -> str | None:
+    """``robot`` if ``name`` is ``topic_of(robot)`` (a robot's own topic), else None."""
+    parts = name.split("/")
+    if len(parts) < 3 or parts[0] or not parts[1]:
+        return None
+    return parts[1] if topic_of(parts[1]) == name else None
 
 
 def teleop_topics(advertised: Mapping[str, Advertisement]) -> dict[str, str]:
     """``/<robot>/cmd_vel`` -> robot, for every robot whose driver takes teleoperation."""
     topics = {}
     for name, ad in advertised.items():
-        robot = _robot_of(name, _TELEOP_LEAF)
+        robot = _robot_of(name, teleop_topic)
         if ad.message_type is Twist and robot:
-            topics[f"/{robot}/cmd_vel"] = robot
+            topics[cmd_vel_topic(robot)] = robot
     return topics
-
-
-def teleop_bus_topic(robot: str) -> str:
-    """The bus topic a Unity command for ``robot`` is published on."""
-    return f"/{robot}{_TELEOP_LEAF}"
 
 
 def decode_twist(robot: str, data: bytes) -> UnityTwist:
@@ -172,12 +165,12 @@ def decode_twist(robot: str, data: bytes) -> UnityTwist:
     Raises:
         ValueError: naming what is wrong (bytes that do not decode, a value not finite).
     """
-    message = _decode(f"/{robot}/cmd_vel", data, TWIST_TYPE)
-    linear, angular = message.linear, message.angular
-    values = [float(v) for v in (linear.x, linear.y, linear.z, angular.x, angular.y, angular.z)]
+    topic = cmd_vel_topic(robot)
+    linear, angular = _decode(topic, data, std.TWIST)
+    values = [float(v) for v in (*linear, *angular)]
     if not all(math.isfinite(v) for v in values):
         raise ValueError(
-            f"/{robot}/cmd_vel: linear {values[:3]}, angular {values[3:]}; expected finite "
+            f"{topic}: linear {values[:3]}, angular {values[3:]}; expected finite "
             "numbers (m/s, rad/s)"
         )
     return UnityTwist(robot, values[0], values[5])

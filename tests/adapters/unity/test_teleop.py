@@ -8,11 +8,11 @@ from collections.abc import Iterator
 
 import pytest
 
+from adapters.unity.server import UnityOptions, UnitySink
 from cosim.core.bus import Bus
 from cosim.core.kernel import Kernel
 from cosim.core.messages import Message, Twist
 from cosim.recording.schemas import channel_specs
-from cosim.recording.unity import UnityOptions, UnitySink
 from tests.cosim.recording.connector import Connector, goal_pose_cdr, twist_cdr
 
 REGISTER = {"message_name": "geometry_msgs/Twist", "queue_size": 10, "latch": False}

@@ -3,8 +3,8 @@
 A Unity scene attached to ``cosim run --unity`` (its ROS-TCP-Connector) publishes a
 ``geometry_msgs/PoseStamped`` in ``map`` for each tracked robot, on the robot's body topic
 (``mocap.bodies``, or ``mocap.topic_pattern``, ``/{robot}/pose`` by default). The source
-does not see the Unity server: the hand-over is the run's bus. Each body topic is
-advertised as ``/unity`` + the topic (``/unity/robot_1/pose``,
+does not see the Unity endpoint (:mod:`adapters.unity.server`): the hand-over is the run's
+bus. Each body topic is advertised as ``/unity`` + the topic (``/unity/robot_1/pose``,
 :class:`~cosim.core.messages.PoseStamped`); the server finds these advertisements, lets
 scenes ``__publish`` on the topics behind the prefix, checks every sample (a CDR
 PoseStamped, in ``map``, finite) and publishes the newest one of each topic from the
@@ -22,19 +22,11 @@ from adapters.mocap.contract import SourceContext, Tracked
 from adapters.mocap.live import PolledSource, Sample
 from adapters.mocap.ros2 import pattern_tracks, topic_bodies_problems
 from adapters.mocap.settings import MocapConfig
+from adapters.unity.topics import pose_bus_topic
 from cosim.core.adapter import RunContext
 from cosim.core.bus import Envelope
 from cosim.core.messages import Message, PoseStamped
 from cosim.scenario.fields import Problem
-
-UNITY_PREFIX = "/unity"
-"""Bus topics carrying Unity's poses: this prefix and the Unity-side topic (the Unity
-server in ``cosim.recording.unity.inbound`` spells it the same)."""
-
-
-def unity_bus_topic(body: str) -> str:
-    """The bus topic of the poses a scene publishes on ``body`` (``/unity/robot_1/pose``)."""
-    return UNITY_PREFIX + body
 
 
 class UnityPoseSource(PolledSource):
@@ -67,12 +59,12 @@ class UnityPoseSource(PolledSource):
         self.received = 0
         self.not_in_map = 0
         for _index, body in context.tracked:  # now, so that the Unity server finds them
-            context.run.bus.advertise(unity_bus_topic(body), PoseStamped)
+            context.run.bus.advertise(pose_bus_topic(body), PoseStamped)
 
     def connect(self, run: RunContext) -> None:
         """Listen on every body's bus topic on the ``mocap`` host."""
         for index, body in self.context.tracked:
-            run.bus.subscribe(unity_bus_topic(body), self.context.host, self._on_pose(index))
+            run.bus.subscribe(pose_bus_topic(body), self.context.host, self._on_pose(index))
 
     def _on_pose(self, index: int) -> Any:
         def on_pose(message: Message, _envelope: Envelope) -> None:
