@@ -26,7 +26,7 @@ import numpy as np
 
 from models.network import (
     BernoulliLoss,
-    Fate,
+    DeliveryStatus,
     GilbertElliottLoss,
     LinkParams,
     LossProcess,
@@ -77,7 +77,7 @@ def _run(loss: Callable[[], LossProcess], broadcast: bool, seed: int) -> tuple[i
     results = [transmit(t, src, dsts, NBYTES, _no_distance) for t, src, dsts in plan]
     wall = time.perf_counter() - start
     outcomes = sum(len(r) for r in results)
-    delivered = sum(1 for r in results for _, fate, _ in r if fate is Fate.DELIVERED)
+    delivered = sum(1 for r in results for _, fate, _ in r if fate is DeliveryStatus.DELIVERED)
     return outcomes, delivered, wall
 
 

@@ -2,10 +2,10 @@
 
 import mkdocs_gen_files
 
-from cosim.reference.commands import commands_markdown
-from cosim.reference.keys import keys_markdown
-from cosim.reference.registries import registries_markdown
-from cosim.reference.tables import tables_markdown
+from cosim.reference.commands_page import commands_markdown
+from cosim.reference.keys_page import keys_markdown
+from cosim.reference.registries_page import registries_markdown
+from cosim.reference.tables_page import tables_markdown
 
 PAGES = {
     "reference/scenario-keys.md": keys_markdown,

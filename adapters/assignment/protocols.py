@@ -2,7 +2,7 @@
 
 - ``distributed_simplex``: distributed simplex (Buerger, Notarstefano, Bullo, Allgoewer
   2012), the protocol of ChoiRbot and VirTooS: robots exchange bases and halt together;
-- ``cbba``: a consensus-based auction (CBAA, Choi, Brunet, How 2009);
+- ``cbba``: a consensus-based auction (CBBA with one task per robot, Choi, Brunet, How 2009);
 - ``greedy``: each robot takes the nearest task nobody has claimed, exchanging nothing;
 - ``hungarian``: the centralized optimum (Kuhn's Hungarian method, scipy) on the base station.
 
@@ -20,8 +20,8 @@ import numpy as np
 
 from adapters.assignment.contract import EpochView, ProtocolAgent, ProtocolBase, ProtocolFleet
 from adapters.assignment.topics import BASES, BIDS
-from cosim.core.messages import AuctionBids, Message, SimplexBasis, TaskInfo
-from models.assignment.cbaa import CbaaAgent, scores_from_cost
+from cosim.core.messages import CbbaBids, Message, SimplexBasis, TaskInfo
+from models.assignment.cbba import CbbaAgent, scores_from_cost
 from models.assignment.dsimplex import SharedBasis, agent_for
 from models.assignment.greedy import nearest_free
 from models.assignment.problem import AssignmentProblem, hungarian
@@ -111,7 +111,7 @@ class SimplexProtocol:
 
 
 class CbbaProtocol:
-    """Consensus-based auction (CBAA, Choi, Brunet, How 2009) with bids = reward - cost.
+    """CBBA, one task per robot (Choi, Brunet, How 2009), with bids = reward - cost.
 
     Bids of different robots are compared, so the reward must be the same for everyone:
     a constant above any cost in the hall (``reward_m``), not derived from a robot's own row.
@@ -132,19 +132,19 @@ class CbbaProtocol:
         self.epoch = epoch
         self.diameter = diameter
         scores = scores_from_cost(problem.cost, reward_m)
-        self.agent = CbaaAgent(robot, scores[robot], len(problem.robots))
+        self.agent = CbbaAgent(robot, scores[robot], len(problem.robots))
 
     def round(self, inbox: list[Message], now_ns: int) -> tuple[Message | None, bool]:
         """Bid, then reach consensus on the winners with the neighbours' views."""
         received = [
             (np.asarray(m.bids, dtype=float), np.asarray(m.winners, dtype=np.int64))
             for m in inbox
-            if isinstance(m, AuctionBids) and m.epoch == self.epoch
+            if isinstance(m, CbbaBids) and m.epoch == self.epoch
         ]
         changed = self.agent.bid()
         changed = self.agent.consensus(received) or changed
         y, z = self.agent.message()
-        message = AuctionBids(
+        message = CbbaBids(
             now_ns, self.epoch, self.name, tuple(float(v) for v in y), tuple(int(v) for v in z)
         )
         return message, changed
@@ -231,10 +231,10 @@ class DistributedSimplex(ProtocolBase):
 
 
 class Cbba(ProtocolBase):
-    """Consensus-based auction (CBAA, Choi, Brunet, How 2009): robots exchange bids."""
+    """CBBA, one task per robot (Choi, Brunet, How 2009): robots exchange their bids."""
 
     name: ClassVar[str] = "cbba"
-    message: ClassVar[type[Message] | None] = AuctionBids
+    message: ClassVar[type[Message] | None] = CbbaBids
     topic: ClassVar[str | None] = BIDS
     compare_to_optimum: ClassVar[bool] = True
 

@@ -5,6 +5,6 @@ from __future__ import annotations
 BASES = "/fleet/dta/bases"
 """SimplexBasis broadcasts among robots (distributed simplex)."""
 BIDS = "/fleet/dta/bids"
-"""AuctionBids broadcasts among robots (CBBA)."""
+"""CbbaBids broadcasts among robots (CBBA)."""
 ASSIGNMENT = "/fleet/assignment"
 """TaskAssignment: what each robot's protocol decided (for tools; nothing subscribes)."""

@@ -3,7 +3,7 @@
 ``mocap.source`` names a registered pose source (:mod:`adapters.mocap.contract`):
 ``simulated`` (:mod:`adapters.mocap.simulated`), ``bag`` (:mod:`adapters.mocap.replay`),
 ``motioncapture`` (:mod:`adapters.mocap.motioncapture`), ``ros2``
-(:mod:`adapters.mocap.ros2`), ``unity`` (:mod:`adapters.unity.poses`), or a plugin's.
+(:mod:`adapters.mocap.ros2`), ``unity`` (:mod:`adapters.unity.pose_source`), or a plugin's.
 The robots an external source tracks are twins that follow its poses; those a simulated
 one tracks drive by their commands. A live source never makes the run wait: one that
 fails ends the run at once, and one that has sent no pose of some tracked robot

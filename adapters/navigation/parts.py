@@ -28,7 +28,6 @@ from adapters.navigation.contract import (
 )
 from adapters.navigation.fleet_traffic import FleetTraffic
 from adapters.navigation.goal_tracking import Drivers, GoalTracker
-from adapters.navigation.interface import NavInterface
 from adapters.navigation.layers import StaticLayers, padded, robot_layers, static_costmap
 from adapters.navigation.localization import Localization
 from adapters.navigation.off_map import OffMapWatch
@@ -37,6 +36,7 @@ from adapters.navigation.recovery import Recovery, StallWatch
 from adapters.navigation.scan_memory import MovingMemory, ScanMemory
 from adapters.navigation.settings import NavigationConfig
 from adapters.navigation.tables import NavRecords
+from adapters.navigation.wiring import NavWiring
 from cosim.core.adapter import RunContext
 from cosim.core.errors import ConfigError
 from cosim.core.hosts import HostId
@@ -101,7 +101,7 @@ class NavigationParts:
     recovery: Recovery
     stalls: StallWatch
     goals: GoalTracker
-    interface: NavInterface
+    interface: NavWiring
     planning: GlobalPlanning
     off_map: OffMapWatch
     traffic: TrafficParams
@@ -149,7 +149,7 @@ def build_parts(run: RunContext) -> NavigationParts:
     )
     recovery = Recovery(n, memory, limits, radius, rngs)
     stalls = StallWatch(pose)
-    interface = NavInterface.of(names, hosts)
+    interface = NavWiring.of(names, hosts)
     goals = GoalTracker(
         fleet,
         hosts,

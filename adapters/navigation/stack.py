@@ -16,7 +16,7 @@ it at ``control_hz``, keeping clear of the latest scan's hits. Blocked robots re
 wait, rotate, back up, replan.
 
 The adapter runs the ticks; its parts are built in :mod:`adapters.navigation.parts`, its
-topics wired in :mod:`adapters.navigation.interface`.
+topics wired in :mod:`adapters.navigation.wiring`.
 """
 
 from __future__ import annotations

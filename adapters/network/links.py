@@ -33,13 +33,12 @@ from cosim.core.adapter import RunContext
 from cosim.core.errors import ConfigError
 from cosim.core.hosts import HostId, HostKind
 from cosim.core.kernel import Stage
-from cosim.core.link import AllDelivered, DeliveryStatus, Transfer
+from cosim.core.link import AllDelivered, Transfer
 from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns, s_to_ns
 from cosim.scenario.fields import model_problem
 from models.errors import ModelError
 from models.fleet.kinematics import FleetState
-from models.network.fate import Fate
 from models.network.model import LinkParams, NetworkModel, Partition
 from models.network.radio import PathLoss
 from models.network.topology import Edges, edge
@@ -58,7 +57,6 @@ LINKS = TableSpec(
     categorical=("a", "b"),
 )
 LINK_COLUMNS = tuple(LINKS.columns)
-_STATUS = {fate: DeliveryStatus(fate.value) for fate in Fate}
 
 
 def _checked(source: str, make: Callable[[], T]) -> T:
@@ -139,10 +137,10 @@ class ModelLink:
             latencies.extend([outcome - t_ns] * len(dsts))
             return AllDelivered(outcome)
         out = []
-        for dst, fate, arrival in outcome:
+        for dst, status, arrival in outcome:
             if arrival is not None:
                 latencies.append(arrival - t_ns)
-            out.append(Transfer(HostId(dst), _STATUS[fate], arrival))
+            out.append(Transfer(HostId(dst), status, arrival))
         return out
 
 

@@ -14,7 +14,7 @@ driver clips it to the robot's limits and stops the robot when commands stop.
 
 A ``geometry_msgs/PoseStamped`` (``map``) on a tracked robot's body topic serves as its
 motion capture (``mocap.source = "unity"``): the pose source
-(:mod:`adapters.unity.poses`) advertises the bus topic of each body
+(:mod:`adapters.unity.pose_source`) advertises the bus topic of each body
 (:func:`~adapters.unity.topics.pose_bus_topic`, ``/unity/robot_1/pose``), and the checked
 poses are published there from the ``mocap`` host for its pose intake.
 """

@@ -24,7 +24,7 @@ import simpy
 
 from cosim.core.hosts import HostId
 from cosim.core.kernel import Kernel, Stage
-from cosim.core.link import AllDelivered, DeliveryStatus, IdealLink, Link, Transfer
+from cosim.core.link import DELIVERED, AllDelivered, IdealLink, Link, Transfer
 from cosim.core.messages import Message
 
 
@@ -89,7 +89,7 @@ class BusTap(Protocol):
         dst: HostId,
         topic: str,
         nbytes: int,
-        status: DeliveryStatus,
+        status: str,
     ) -> None:
         """Record one message towards one destination host."""
         ...
@@ -215,7 +215,7 @@ class Bus:
             )
         routes, tap = self._routes, self.tap
         now = int(self.kernel.env.now)
-        delivered = DeliveryStatus.DELIVERED
+        delivered = DELIVERED
         for topic, message, src in zip(topics, messages, sources, strict=True):
             self.published += 1
             route = routes.get((topic, src))
@@ -293,7 +293,7 @@ class Bus:
             self.tap.on_transmission(t_sent_ns, src, topic, nbytes, transfers)
         arrivals: dict[int, list[HostId]] = {}
         for transfer in transfers:
-            if transfer.status is not DeliveryStatus.DELIVERED or transfer.t_recv_ns is None:
+            if transfer.status != DELIVERED or transfer.t_recv_ns is None:
                 continue
             if transfer.t_recv_ns < t_sent_ns:
                 delay = transfer.t_recv_ns - t_sent_ns

@@ -9,20 +9,16 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from enum import StrEnum
 from typing import Protocol
 
 from cosim.core.hosts import HostId
 
+DELIVERED = "delivered"
+"""The status of a copy that arrived; any other status names why one was dropped.
 
-class DeliveryStatus(StrEnum):
-    """Fate of one message towards one destination host."""
-
-    DELIVERED = "delivered"
-    LOST = "lost"
-    QUEUE_FULL = "queue_full"
-    OUT_OF_RANGE = "out_of_range"
-    PARTITIONED = "partitioned"
+A link says what happened to each copy in its own words: the built-in network model's are
+those of ``models.network.delivery.DeliveryStatus`` (``lost``, ``queue_full``,
+``out_of_range``, ``partitioned``); another backend may name its own."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -31,12 +27,12 @@ class Transfer:
 
     Attributes:
         dst: destination host.
-        status: delivered or why not.
+        status: :data:`DELIVERED`, or why not (the link's words).
         t_recv_ns: arrival time (ns) when delivered, else ``None``.
     """
 
     dst: HostId
-    status: DeliveryStatus
+    status: str
     t_recv_ns: int | None
 
 
@@ -44,7 +40,7 @@ class Transfer:
 class AllDelivered:
     """Outcome of a transmission delivered to every destination host at one instant.
 
-    The same as a :class:`Transfer` per destination, in order, each ``DELIVERED`` at
+    The same as a :class:`Transfer` per destination, in order, each :data:`DELIVERED` at
     ``t_recv_ns``, without building them (a broadcast on an ideal network).
 
     Attributes:

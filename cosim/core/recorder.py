@@ -17,7 +17,7 @@ import numpy as np
 import numpy.typing as npt
 
 from cosim.core.hosts import HostId
-from cosim.core.link import DeliveryStatus, Transfer
+from cosim.core.link import DELIVERED, Transfer
 from cosim.core.table import Interner, Table, TableSpec
 
 
@@ -112,7 +112,8 @@ class Recorder:
         self.volatile: dict[str, tuple[str, ...]] = {}
         self.maps: dict[str, MapArtifact] = {}
         self.files: dict[str, bytes] = {}
-        self.counts: dict[str, int] = {status.value: 0 for status in DeliveryStatus}
+        self.counts: dict[str, int] = {DELIVERED: 0}
+        """Copies by delivery status (``delivered``, and each drop reason met)."""
         self.network_messages = 0
         self.network_bytes = 0
 
@@ -125,10 +126,10 @@ class Recorder:
         dst: HostId,
         topic: str,
         nbytes: int,
-        status: DeliveryStatus,
+        status: str,
     ) -> None:
         """Record one message towards one destination host (see :class:`cosim.core.bus.BusTap`)."""
-        self.counts[status] += 1
+        self.counts[status] = self.counts.get(status, 0) + 1
         if src != dst:
             self.network_messages += 1
             self.network_bytes += nbytes
@@ -159,7 +160,7 @@ class Recorder:
         dsts = [t.dst for t in transfers]
         counts = self.counts
         for status in statuses:
-            counts[status] += 1
+            counts[status] = counts.get(status, 0) + 1
         t_recv = [-1 if t.t_recv_ns is None else t.t_recv_ns for t in transfers]
         self._rows(t_sent_ns, src, topic, nbytes, dsts, t_recv, statuses)
 
@@ -180,7 +181,7 @@ class Recorder:
         n = len(dsts)
         if not n:
             return
-        delivered = DeliveryStatus.DELIVERED
+        delivered = DELIVERED
         self.counts[delivered] += n
         self._rows(t_sent_ns, src, topic, nbytes, dsts, [t_recv_ns] * n, [delivered] * n)
 
@@ -192,7 +193,7 @@ class Recorder:
         nbytes: int,
         dsts: Sequence[HostId],
         t_recv_ns: list[int],
-        statuses: list[DeliveryStatus],
+        statuses: list[str],
     ) -> None:
         """Network counts and (when recording) the rows of one transmission's copies."""
         n = len(dsts)

@@ -15,10 +15,10 @@ import pandas as pd
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from cosim.core.link import DeliveryStatus
 from cosim.plotting.canvas import save_png
 from cosim.plotting.rundata import RunData
 from models.arrays import FloatArray, IntArray
+from models.network.delivery import DeliveryStatus
 
 StrArray = npt.NDArray[np.str_]
 

@@ -12,7 +12,7 @@ Two greedy orders are offered:
   coordination would do.
 - :func:`greedy_global`: the globally cheapest (robot, task) pair is fixed first, then
   the cheapest among the remaining robots and tasks, and so on. This is the sequential
-  greedy algorithm (SGA) that the consensus-based auction (``models.assignment.cbaa``)
+  greedy algorithm (SGA) that the consensus-based auction (``models.assignment.cbba``)
   reaches without a central node.
 
 Neither is optimal in total cost (the Hungarian method is); see the tests for instances.

@@ -8,7 +8,7 @@ numbers of another link.
 
 from __future__ import annotations
 
-from models.network.fate import Fate
+from models.network.delivery import DeliveryStatus
 from models.network.interface import InterfaceQueue
 from models.network.latency import (
     ConstantLatency,
@@ -25,8 +25,8 @@ from models.network.radio import PathLoss
 __all__ = [
     "BernoulliLoss",
     "ConstantLatency",
+    "DeliveryStatus",
     "EmpiricalLatency",
-    "Fate",
     "GilbertElliottLoss",
     "InterfaceQueue",
     "LatencyModel",

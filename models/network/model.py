@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from models.errors import ModelError
-from models.network.fate import Fate
+from models.network.delivery import DeliveryStatus
 from models.network.interface import InterfaceQueue
 from models.network.latency import ConstantLatency, LatencyModel
 from models.network.loss import LossProcess, NoLoss
@@ -45,14 +45,14 @@ from models.network.topology import Edge, Edges, edge
 
 BLOCK = 256
 
-Outcome = tuple[str, Fate, int | None]
+Outcome = tuple[str, DeliveryStatus, int | None]
 
 # Enum member lookup costs ~0.1 us on Python 3.11; transmit reads these constants instead.
-_DELIVERED = Fate.DELIVERED
-_LOST = Fate.LOST
-_QUEUE_FULL = Fate.QUEUE_FULL
-_OUT_OF_RANGE = Fate.OUT_OF_RANGE
-_PARTITIONED = Fate.PARTITIONED
+_DELIVERED = DeliveryStatus.DELIVERED
+_LOST = DeliveryStatus.LOST
+_QUEUE_FULL = DeliveryStatus.QUEUE_FULL
+_OUT_OF_RANGE = DeliveryStatus.OUT_OF_RANGE
+_PARTITIONED = DeliveryStatus.PARTITIONED
 DistanceFn = Callable[[str, str], float | None]
 
 

@@ -6,10 +6,10 @@ import re
 
 import cosim
 from cosim.cli.args import build_parser
-from cosim.reference.commands import commands_markdown
-from cosim.reference.keys import keys_markdown
-from cosim.reference.registries import registries_markdown
-from cosim.reference.tables import documented_tables, tables_markdown
+from cosim.reference.commands_page import commands_markdown
+from cosim.reference.keys_page import keys_markdown
+from cosim.reference.registries_page import registries_markdown
+from cosim.reference.tables_page import documented_tables, tables_markdown
 from cosim.scenario import dump_scenario
 from tests.conftest import cosim_main
 

@@ -34,7 +34,7 @@ from cosim.core.messages.aliases import (
     uint32,
     uint64,
 )
-from cosim.core.messages.assignment import AuctionBids, SimplexBasis, TaskAssignment, TaskOrder
+from cosim.core.messages.assignment import CbbaBids, SimplexBasis, TaskAssignment, TaskOrder
 from cosim.core.messages.declare import Message, ros_message
 from cosim.core.messages.mapping import LocalizedScan, MapUpdate
 from cosim.core.messages.navigation import NavGoal, NavStatus, RobotState
@@ -52,8 +52,8 @@ from cosim.core.messages.tf import Clock, TFMessage, Transform
 from cosim.core.messages.views import Const, Each, Outer, Planar, Rows
 
 __all__ = [
-    "AuctionBids",
     "Bytes",
+    "CbbaBids",
     "Clock",
     "Const",
     "Duration",

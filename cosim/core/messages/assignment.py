@@ -39,9 +39,9 @@ class SimplexBasis(Message):
     columns: Annotated[tuple[Column, ...], Sequence(SIMPLEX_COLUMN)]
 
 
-@ros_message("cosim_msgs/msg/AuctionBids")
-class AuctionBids(Message):
-    """A robot's view of the winning bids (CBBA consensus; ``cosim_msgs/msg/AuctionBids``).
+@ros_message("cosim_msgs/msg/CbbaBids")
+class CbbaBids(Message):
+    """A robot's view of the winning bids (CBBA consensus; ``cosim_msgs/msg/CbbaBids``).
 
     Attributes:
         stamp_ns: send time, ns.
@@ -103,7 +103,7 @@ class TaskAssignment(Message):
 
 __all__ = [
     "SIMPLEX_COLUMN",
-    "AuctionBids",
+    "CbbaBids",
     "Column",
     "SimplexBasis",
     "TaskAssignment",

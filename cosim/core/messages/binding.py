@@ -14,7 +14,7 @@ from typing import Annotated, Any, get_args, get_origin
 
 import numpy as np
 
-from cosim.core.messages.layout import Source
+from cosim.core.messages.cdr_layout import Source
 
 
 @dataclass(frozen=True)

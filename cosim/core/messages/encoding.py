@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from cosim.core.messages.layout import (
+from cosim.core.messages.cdr_layout import (
     Let,
     Loop,
     Op,

@@ -16,7 +16,7 @@ from cosim.core.errors import WireError
 from cosim.core.messages import std
 from cosim.core.messages.aliases import HeaderFrame, HeaderStamp
 from cosim.core.messages.binding import ClassBinding, convert, element_class
-from cosim.core.messages.layout import AsTuple, Expr, Fields, Items, Source
+from cosim.core.messages.cdr_layout import AsTuple, Expr, Fields, Items, Source
 from cosim.core.messages.wire import (
     BOOL,
     FLOAT64,

@@ -18,7 +18,7 @@ from typing import Any
 
 from cosim.core.errors import WireError
 from cosim.core.messages.binding import ClassBinding, convert
-from cosim.core.messages.layout import AsTuple, Expr, Fields, Items, Source
+from cosim.core.messages.cdr_layout import AsTuple, Expr, Fields, Items, Source
 from cosim.core.messages.wire import Sequence, Struct, WireType
 
 

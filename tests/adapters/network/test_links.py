@@ -14,13 +14,14 @@ from cosim.core.adapter import RunContext
 from cosim.core.errors import ConfigError
 from cosim.core.hosts import BASE_HOST, HostId
 from cosim.core.kernel import Stage
-from cosim.core.link import AllDelivered, DeliveryStatus, Transfer
+from cosim.core.link import AllDelivered, Transfer
 from cosim.core.messages import Message
 from cosim.core.registry import AdapterRegistry
 from cosim.core.rng import RngStreams
 from cosim.runner.execute import execute
 from models.fleet.kinematics import FleetState
 from models.network import ConstantLatency, LinkParams, NetworkModel, NoLoss
+from models.network.delivery import DeliveryStatus
 from models.network.topology import complete
 
 

@@ -7,11 +7,12 @@ import pytest
 from cosim.core.bus import Bus, Envelope
 from cosim.core.hosts import HostId
 from cosim.core.kernel import Kernel, Stage
-from cosim.core.link import AllDelivered, DeliveryStatus, Transfer
+from cosim.core.link import AllDelivered, Transfer
 from cosim.core.messages import Message, Twist
 from cosim.core.recorder import Recorder
 from cosim.core.timebase import period_ns
 from cosim.recording.dataframes import messages_frame
+from models.network.delivery import DeliveryStatus
 
 A, B, C = HostId("a"), HostId("b"), HostId("c")
 

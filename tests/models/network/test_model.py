@@ -5,7 +5,7 @@ from models.errors import ModelError
 from models.network import (
     BernoulliLoss,
     ConstantLatency,
-    Fate,
+    DeliveryStatus,
     GilbertElliottLoss,
     LinkParams,
     NetworkModel,
@@ -36,7 +36,9 @@ def network(streams, *, latency=None, loss=NoLoss, bandwidth_bps=None, queue=100
 def test_a_constant_5_ms_latency_delivers_exactly_5_ms_after_sending(streams):
     net = network(streams, latency=ConstantLatency(5.0))
     for t in [0, 1, 999_999, 3 * MS, 3 * MS, 10**12 + 7]:
-        assert net.transmit(t, "a", ["b"], 100, no_distance) == [("b", Fate.DELIVERED, t + 5 * MS)]
+        assert net.transmit(t, "a", ["b"], 100, no_distance) == [
+            ("b", DeliveryStatus.DELIVERED, t + 5 * MS)
+        ]
 
 
 def test_back_to_back_1250_byte_messages_at_1_mbit_s_arrive_10_ms_apart(streams):
@@ -47,14 +49,16 @@ def test_back_to_back_1250_byte_messages_at_1_mbit_s_arrive_10_ms_apart(streams)
 
 def test_serialization_and_latency_add_up(streams):
     net = network(streams, latency=ConstantLatency(2.5), bandwidth_bps=1e6)
-    assert net.transmit(1 * MS, "a", ["b"], 125, no_distance) == [("b", Fate.DELIVERED, 4_500_000)]
+    assert net.transmit(1 * MS, "a", ["b"], 125, no_distance) == [
+        ("b", DeliveryStatus.DELIVERED, 4_500_000)
+    ]
 
 
 def _arrivals(net, n, gap_ns):
     out = []
     for k in range(n):
         [(_, fate, t)] = net.transmit(k * gap_ns, "a", ["b"], 100, no_distance)
-        assert fate is Fate.DELIVERED
+        assert fate is DeliveryStatus.DELIVERED
         out.append(t)
     return np.array(out)
 
@@ -79,7 +83,7 @@ def test_fifo_holds_back_a_message_only_until_the_previous_one_arrived(streams):
 
 
 def test_loss_probability_1_drops_every_message_and_0_drops_none(streams):
-    for p, fate in [(1.0, Fate.LOST), (0.0, Fate.DELIVERED)]:
+    for p, fate in [(1.0, DeliveryStatus.LOST), (0.0, DeliveryStatus.DELIVERED)]:
         net = network(streams, loss=lambda p=p: BernoulliLoss(p))
         fates = {
             net.transmit(k, "a", ["b", "c"], 10, no_distance)[i][1]
@@ -96,10 +100,10 @@ def test_a_partition_drops_exactly_the_messages_sent_inside_its_window(streams):
     for t in range(0, 30 * MS, MS // 2):
         for src, dst in [("a", "b"), ("b", "a"), ("b", "c")]:
             [(_, fate, _)] = net.transmit(t, src, [dst], 10, no_distance)
-            if fate is Fate.PARTITIONED:
+            if fate is DeliveryStatus.PARTITIONED:
                 partitioned[f"{src}->{dst}"].append(t)
             else:
-                assert fate is Fate.DELIVERED
+                assert fate is DeliveryStatus.DELIVERED
     inside = list(range(10 * MS, 20 * MS, MS // 2))
     assert partitioned == {"a->b": inside, "b->a": inside, "b->c": []}
 
@@ -109,8 +113,8 @@ def test_a_partition_of_explicit_links_cuts_only_those_links(streams):
     assert cut.links == {("a", "c")}
     net = network(streams, partitions=[cut])
     fates = [f for _, f, _ in net.transmit(0, "a", ["b", "c"], 10, no_distance)]
-    assert fates == [Fate.DELIVERED, Fate.PARTITIONED]
-    assert net.transmit(MS, "c", ["a"], 10, no_distance)[0][1] is Fate.DELIVERED
+    assert fates == [DeliveryStatus.DELIVERED, DeliveryStatus.PARTITIONED]
+    assert net.transmit(MS, "c", ["a"], 10, no_distance)[0][1] is DeliveryStatus.DELIVERED
 
 
 def test_beyond_range_every_message_is_out_of_range_and_unknown_positions_are_not(streams):
@@ -118,7 +122,11 @@ def test_beyond_range_every_message_is_out_of_range_and_unknown_positions_are_no
     net = network(streams, range_m=50.0)
     for k in range(200):
         out = net.transmit(k, "a", ["b", "c", "d"], 10, lambda s, d: distances[(s, d)])
-        assert [f for _, f, _ in out] == [Fate.DELIVERED, Fate.OUT_OF_RANGE, Fate.DELIVERED]
+        assert [f for _, f, _ in out] == [
+            DeliveryStatus.DELIVERED,
+            DeliveryStatus.OUT_OF_RANGE,
+            DeliveryStatus.DELIVERED,
+        ]
 
 
 def test_reception_under_path_loss_falls_with_distance_as_the_model_predicts(streams):
@@ -130,9 +138,12 @@ def test_reception_under_path_loss_falls_with_distance_as_the_model_predicts(str
     fates = set()
     for k in range(n):
         for dst, fate, _ in net.transmit(k, "src", list(hosts), 10, lambda s, d: hosts[d]):
-            received[dst] += fate is Fate.DELIVERED
+            received[dst] += fate is DeliveryStatus.DELIVERED
             fates.add((dst, fate))
-    assert ("d150", Fate.OUT_OF_RANGE) in fates and ("d150", Fate.DELIVERED) not in fates
+    assert ("d150", DeliveryStatus.OUT_OF_RANGE) in fates and (
+        "d150",
+        DeliveryStatus.DELIVERED,
+    ) not in fates
     rates = [received[h] / n for h in ["d10", "d50", "d70", "d90"]]
     assert rates == sorted(rates, reverse=True)
     for host in ["d10", "d50", "d70", "d90"]:
@@ -144,20 +155,26 @@ def test_pairs_outside_the_topology_are_out_of_range(streams):
     net = network(streams)
     net.set_edges(ring(["a", "b", "c", "d"]))
     out = net.transmit(0, "a", ["b", "c", "d"], 10, no_distance)
-    assert [f for _, f, _ in out] == [Fate.DELIVERED, Fate.OUT_OF_RANGE, Fate.DELIVERED]
+    assert [f for _, f, _ in out] == [
+        DeliveryStatus.DELIVERED,
+        DeliveryStatus.OUT_OF_RANGE,
+        DeliveryStatus.DELIVERED,
+    ]
     net.set_edges(None)
     out = net.transmit(0, "a", ["c"], 10, no_distance)
-    assert out[0][1] is Fate.DELIVERED
+    assert out[0][1] is DeliveryStatus.DELIVERED
 
 
 def test_a_full_queue_refuses_every_destination_with_exact_counts(streams):
     net = network(streams, bandwidth_bps=1e6, queue=2)
     fates = [net.transmit(0, "a", ["b", "c"], 1250, no_distance) for _ in range(5)]
-    assert [[f for _, f, _ in out] for out in fates] == [[Fate.DELIVERED] * 2] * 3 + [
-        [Fate.QUEUE_FULL] * 2
+    assert [[f for _, f, _ in out] for out in fates] == [[DeliveryStatus.DELIVERED] * 2] * 3 + [
+        [DeliveryStatus.QUEUE_FULL] * 2
     ] * 2
     # another host's interface is not affected
-    assert net.transmit(0, "b", ["a"], 1250, no_distance) == [("a", Fate.DELIVERED, 10 * MS)]
+    assert net.transmit(0, "b", ["a"], 1250, no_distance) == [
+        ("a", DeliveryStatus.DELIVERED, 10 * MS)
+    ]
 
 
 def test_a_broadcast_is_serialized_once_for_all_receivers(streams):
@@ -173,7 +190,10 @@ def test_broadcast_receivers_lose_messages_independently(streams):
     n = 5000
     lost = np.array(
         [
-            [f is Fate.LOST for _, f, _ in net.transmit(k, "a", ["b", "c"], 10, no_distance)]
+            [
+                f is DeliveryStatus.LOST
+                for _, f, _ in net.transmit(k, "a", ["b", "c"], 10, no_distance)
+            ]
             for k in range(n)
         ]
     )
@@ -197,7 +217,7 @@ def test_adding_a_host_does_not_change_another_links_fates(make_streams):
 
     alone, crowded = run(False), run(True)
     assert alone == crowded
-    assert {f for _, f, _ in alone} == {Fate.DELIVERED, Fate.LOST}
+    assert {f for _, f, _ in alone} == {DeliveryStatus.DELIVERED, DeliveryStatus.LOST}
 
 
 def test_each_directed_link_gets_its_own_stream_and_loss_process(make_streams):
@@ -284,7 +304,7 @@ def test_an_ideal_network_delivers_as_its_links_would_without_drawing_them(
         dsts = [h for h in hosts if h != src and rng.random() < 0.8]
         outcome = fast.transmit(t, src, dsts, 100, no_distance)
         assert outcome == forced.transmit(t, src, dsts, 100, no_distance)
-        assert outcome == [(d, Fate.DELIVERED, t + round(latency_ms * MS)) for d in dsts]
+        assert outcome == [(d, DeliveryStatus.DELIVERED, t + round(latency_ms * MS)) for d in dsts]
     assert asked[0] == [] and len(asked[1]) == 30
     with pytest.raises(ValueError, match="cannot send to itself"):
         fast.transmit(t, "h0", ["h1", "h0"], 100, no_distance)
@@ -334,6 +354,8 @@ def test_transmitting_to_all_at_once_stands_for_the_outcomes_transmit_lists(
         outcome = at_once.transmit_all(t, src, dsts, 100, no_distance)
         assert isinstance(outcome, int) is ideal
         expanded = (
-            [(d, Fate.DELIVERED, outcome) for d in dsts] if isinstance(outcome, int) else outcome
+            [(d, DeliveryStatus.DELIVERED, outcome) for d in dsts]
+            if isinstance(outcome, int)
+            else outcome
         )
         assert expanded == each.transmit(t, src, dsts, 100, no_distance)

@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from cosim.core.messages import (
-    AuctionBids,
+    CbbaBids,
     Clock,
     Goal,
     LaserScan,
@@ -74,7 +74,7 @@ EXAMPLES: list[Message] = [
     ServiceReply(16, 1, "robot_3", True),
     TaskDone(17, 1, "robot_3"),
     SimplexBasis(18, 4, "robot_1", 3, ((0, 1, 2, 3.5), (1, 0, -1, 1e6))),
-    AuctionBids(19, 4, "robot_2", (1.0, 2.5), (0, -1)),
+    CbbaBids(19, 4, "robot_2", (1.0, 2.5), (0, -1)),
     TaskOrder(20, 4, "robot_2", -1, math.nan),
     TaskAssignment(21, 4, "robot_2", 3, 8.25, 6),
     Clock(3_000_000_007),

@@ -120,7 +120,7 @@ def _hdr(stamp_ns=5, frame="map"):
 
 def test_project_message_sizes_match_their_msg_definitions():
     from cosim.core.messages import (
-        AuctionBids,
+        CbbaBids,
         NavGoal,
         NavStatus,
         RobotState,
@@ -178,7 +178,7 @@ def test_project_message_sizes_match_their_msg_definitions():
             ),
         ),
         (
-            AuctionBids(5, 2, "robot_1", (1.0, 2.0, 3.0), (0, -1, 2)),
+            CbbaBids(5, 2, "robot_1", (1.0, 2.0, 3.0), (0, -1, 2)),
             dict(
                 header=_hdr(),
                 epoch=2,

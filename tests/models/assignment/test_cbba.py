@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from scipy.optimize import linear_sum_assignment
 
-from models.assignment.cbaa import (
-    CbaaAgent,
-    CbaaResult,
+from models.assignment.cbba import (
+    CbbaAgent,
+    CbbaResult,
     convergence_bound,
     graph_diameter,
     run_synchronous,
@@ -61,7 +61,7 @@ def make_instance(seed: int) -> Instance:
 
 
 @pytest.fixture(scope="module")
-def runs() -> list[tuple[Instance, CbaaResult]]:
+def runs() -> list[tuple[Instance, CbbaResult]]:
     instances = [make_instance(seed) for seed in SEEDS]
     return [(inst, run_synchronous(inst.cost, inst.edges)) for inst in instances]
 
@@ -123,7 +123,7 @@ def test_the_total_score_is_at_least_half_of_the_optimum(runs):
         assert achieved >= 0.5 * optimum - 1e-9, inst.seed
 
 
-def test_cbaa_is_not_always_optimal_in_total_cost():
+def test_cbba_is_not_always_optimal_in_total_cost():
     # robot 0 grabs its cheapest task, leaving robot 1 the far one: 1 + 100 against 2 + 2
     cost = np.array([[1.0, 2.0], [2.0, 100.0]])
     result = run_synchronous(cost, [(0, 1)])
@@ -133,7 +133,7 @@ def test_cbaa_is_not_always_optimal_in_total_cost():
     assert cost[rows, cols].sum() == 4.0
 
 
-def test_cbaa_costs_more_than_the_hungarian_optimum_on_many_random_fleets(runs):
+def test_cbba_costs_more_than_the_hungarian_optimum_on_many_random_fleets(runs):
     worse = 0
     for inst, res in runs:
         if np.isinf(inst.cost).any():
@@ -189,7 +189,7 @@ def test_a_line_of_robots_needs_the_news_to_travel_its_diameter():
 
 
 def test_an_agent_bids_on_its_best_task_it_can_win():
-    agent = CbaaAgent(1, [5.0, 9.0, 7.0], n_robots=3)
+    agent = CbbaAgent(1, [5.0, 9.0, 7.0], n_robots=3)
     agent.y[:] = [0.0, 9.5, 0.0]
     agent.z[:] = [-1, 0, -1]
     assert agent.bid()
@@ -199,7 +199,7 @@ def test_an_agent_bids_on_its_best_task_it_can_win():
 
 
 def test_an_agent_wins_a_tie_only_against_a_higher_robot_index():
-    agent = CbaaAgent(1, [4.0, 4.0], n_robots=3)
+    agent = CbbaAgent(1, [4.0, 4.0], n_robots=3)
     agent.y[:] = [4.0, 4.0]
     agent.z[:] = [0, 2]
     assert agent.bid()
@@ -207,14 +207,14 @@ def test_an_agent_wins_a_tie_only_against_a_higher_robot_index():
 
 
 def test_an_agent_never_bids_on_an_ineligible_task():
-    agent = CbaaAgent(0, [np.nan, -np.inf, 2.0], n_robots=1)
+    agent = CbbaAgent(0, [np.nan, -np.inf, 2.0], n_robots=1)
     assert agent.bid() and agent.x == 2
-    lonely = CbaaAgent(0, [np.nan, -np.inf], n_robots=1)
+    lonely = CbbaAgent(0, [np.nan, -np.inf], n_robots=1)
     assert not lonely.bid() and lonely.x is None
 
 
 def test_an_outbid_agent_releases_its_task_and_bids_again():
-    agent = CbaaAgent(1, [6.0, 3.0], n_robots=2)
+    agent = CbbaAgent(1, [6.0, 3.0], n_robots=2)
     agent.bid()
     assert agent.x == 0
     assert agent.consensus([(np.array([6.0, 0.0]), np.array([0, -1]))])  # tie, robot 0 wins
@@ -223,7 +223,7 @@ def test_an_outbid_agent_releases_its_task_and_bids_again():
 
 
 def test_a_better_bid_from_a_neighbour_on_another_task_leaves_the_own_task_held():
-    agent = CbaaAgent(0, [6.0, 3.0], n_robots=2)
+    agent = CbbaAgent(0, [6.0, 3.0], n_robots=2)
     agent.bid()
     assert agent.consensus([(np.array([0.0, 8.0]), np.array([-1, 1]))])
     assert agent.x == 0 and agent.y.tolist() == [6.0, 8.0] and agent.z.tolist() == [0, 1]
@@ -238,18 +238,18 @@ def test_consensus_ignores_message_order_and_duplicates():
     messages = [(y, np.where(y == 0, -1, z)) for y, z in messages]
     merged = []
     for order in ([0, 1, 2, 3, 4], [4, 2, 0, 3, 1], [1, 1, 4, 0, 2, 3, 3]):
-        agent = CbaaAgent(0, np.ones(6), n_robots=4)
+        agent = CbbaAgent(0, np.ones(6), n_robots=4)
         agent.consensus([messages[k] for k in order])
         merged.append((agent.y.tolist(), agent.z.tolist()))
     assert merged[0] == merged[1] == merged[2]
-    one_by_one = CbaaAgent(0, np.ones(6), n_robots=4)
+    one_by_one = CbbaAgent(0, np.ones(6), n_robots=4)
     for k in [3, 0, 4, 1, 2, 0]:  # late and repeated messages one at a time
         one_by_one.consensus([messages[k]])
     assert (one_by_one.y.tolist(), one_by_one.z.tolist()) == merged[0]
 
 
 def test_an_agent_counts_quiet_rounds_until_converged():
-    agent = CbaaAgent(0, [1.0], n_robots=1)
+    agent = CbbaAgent(0, [1.0], n_robots=1)
     agent.bid()
     agent.consensus([])
     assert agent.unchanged_rounds == 0 and not agent.converged(1)
@@ -261,7 +261,7 @@ def test_an_agent_counts_quiet_rounds_until_converged():
 
 
 def test_messages_are_copies():
-    agent = CbaaAgent(0, [1.0, 2.0], n_robots=1)
+    agent = CbbaAgent(0, [1.0, 2.0], n_robots=1)
     message = agent.message()
     message.y[0] = 99.0
     message.z[0] = 5
@@ -270,12 +270,12 @@ def test_messages_are_copies():
 
 def test_malformed_agents_and_messages_are_rejected():
     with pytest.raises(ValueError, match="robot = 3"):
-        CbaaAgent(3, [1.0], n_robots=3)
+        CbbaAgent(3, [1.0], n_robots=3)
     with pytest.raises(ValueError, match="> 0"):
-        CbaaAgent(0, [0.0, 1.0], n_robots=1)
+        CbbaAgent(0, [0.0, 1.0], n_robots=1)
     with pytest.raises(ValueError, match="> 0"):
-        CbaaAgent(0, [np.inf], n_robots=1)
-    agent = CbaaAgent(0, [1.0, 2.0], n_robots=2)
+        CbbaAgent(0, [np.inf], n_robots=1)
+    agent = CbbaAgent(0, [1.0, 2.0], n_robots=2)
     with pytest.raises(ValueError, match="shapes"):
         agent.consensus([(np.zeros(3), np.full(3, -1))])
     with pytest.raises(ValueError, match="winners"):

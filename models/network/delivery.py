@@ -1,12 +1,12 @@
-"""What happened to one message towards one destination host."""
+"""What happened to one message towards one destination host: its delivery status."""
 
 from __future__ import annotations
 
 from enum import StrEnum
 
 
-class Fate(StrEnum):
-    """Fate of one transmission towards one destination.
+class DeliveryStatus(StrEnum):
+    """DeliveryStatus of one transmission towards one destination.
 
     The values are the strings recorded in the messages table.
     """

@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from adapters.navigation.interface import NavInterface
+from adapters.navigation.wiring import NavWiring
 from cosim.core.bus import Bus
 from cosim.core.hosts import HostId
 from cosim.core.kernel import Kernel
@@ -34,10 +34,10 @@ class Heard:
         self.calls.append(("map", i, message))
 
 
-def _wired(*, mapping: bool) -> tuple[Bus, Any, NavInterface, Heard, np.ndarray]:
+def _wired(*, mapping: bool) -> tuple[Bus, Any, NavWiring, Heard, np.ndarray]:
     bus = Bus(Kernel())
     run: Any = SimpleNamespace(bus=bus)
-    interface = NavInterface.of(NAMES, HOSTS)
+    interface = NavWiring.of(NAMES, HOSTS)
     heard: Any = Heard()
     pose = np.array([[1.0, 2.0, 0.0], [3.0, 4.0, 0.5]])
     interface.subscribe(run, heard, heard, pose, heard, mapping=mapping)
@@ -50,7 +50,7 @@ def _scan() -> LaserScan:
 
 def test_each_robots_status_command_and_plan_topics_are_advertised_robot_by_robot():
     bus = Bus(Kernel())
-    NavInterface.of(NAMES, HOSTS).advertise(bus)
+    NavWiring.of(NAMES, HOSTS).advertise(bus)
     advertised = [(topic, ad.message_type) for topic, ad in bus.advertised().items()]
     assert advertised == [
         ("/robot_1/nav/status", NavStatus),

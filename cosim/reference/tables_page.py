@@ -63,7 +63,7 @@ def tables_markdown() -> str:
         "only values that differ between two runs of the same scenario and seed.",
         "",
         "This page is generated from the tables' declarations (`TableSpec`, "
-        "`cosim/reference/tables.py`).",
+        "`cosim/reference/tables_page.py`).",
         "",
     ]
     for table in documented_tables():

@@ -108,7 +108,7 @@ def keys_markdown() -> str:
         "have implicit limits besides the declared ones (a rate of at least 0.001 Hz, at "
         "most 1 MHz; a time of at most 10⁹ s).",
         "",
-        "This page is generated from the section dataclasses (`cosim/reference/keys.py`).",
+        "This page is generated from the section dataclasses (`cosim/reference/keys_page.py`).",
         "",
     ]
     for name, cls in section_classes().items():

@@ -32,7 +32,7 @@ Handler = Callable[[Message, Envelope], None]
 
 
 @dataclass(frozen=True)
-class NavInterface:
+class NavWiring:
     """The topics of every robot's navigation, and the wiring of what it hears.
 
     Attributes:
@@ -50,7 +50,7 @@ class NavInterface:
     plan: list[str]
 
     @classmethod
-    def of(cls, names: list[str], hosts: list[HostId]) -> NavInterface:
+    def of(cls, names: list[str], hosts: list[HostId]) -> NavWiring:
         """The topics of the robots ``names`` on their ``hosts``."""
         return cls(
             names,

@@ -1,8 +1,10 @@
-"""The Consensus-Based Auction Algorithm (CBAA) for single assignment.
+"""CBBA with one task per robot: the consensus-based auction of single assignment.
 
 Reference: H.-L. Choi, L. Brunet, J. P. How, "Consensus-Based Decentralized Auctions for
-Robust Task Allocation", IEEE Trans. Robotics 25(4):912-926, 2009, Sec. III (CBAA; CBBA,
-the multi-assignment generalization, is in Sec. IV of the same paper).
+Robust Task Allocation", IEEE Trans. Robotics 25(4):912-926, 2009. With one task per robot
+CBBA (Sec. IV, the bundle algorithm) is the single-assignment auction of Sec. III, which
+the paper calls CBAA; cosim names it CBBA throughout, as its scenario key does
+(``assignment.protocol = "cbba"``).
 
 Each robot is an agent that repeats, in rounds, two phases:
 
@@ -24,10 +26,10 @@ What is implemented, precisely:
   max of (bid, winner) over the agent and its neighbours: the synchronous rule of the
   paper's Algorithm 2 with the winner carried along, which is also the CBBA "update"
   action for an agent that hears of a better bid. No time stamps are kept. None are
-  needed in CBAA: a bid is never withdrawn, so the known pair of a task only grows, and
+  needed in CBBA: a bid is never withdrawn, so the known pair of a task only grows, and
   the merge is a join (commutative, associative, idempotent). Messages that arrive late,
   twice or out of order therefore cannot undo newer information; they only delay it.
-  (CBBA needs time stamps because releasing a bundle resets later bids; CBAA has no
+  (CBBA needs time stamps because releasing a bundle resets later bids; CBBA has no
   bundles.)
 
 Properties (consistent scores: each agent's scores are fixed; Sec. III of the paper):
@@ -60,7 +62,7 @@ from models.network.topology import hops_from
 NO_WINNER = -1
 
 
-class CbaaMessage(NamedTuple):
+class CbbaMessage(NamedTuple):
     """What an agent sends its neighbours: its known winning bids and winners.
 
     Attributes:
@@ -72,8 +74,8 @@ class CbaaMessage(NamedTuple):
     z: IntArray
 
 
-class CbaaAgent:
-    """One robot's CBAA state machine, without time or transport.
+class CbbaAgent:
+    """One robot's CBBA state machine, without time or transport.
 
     A round is :meth:`bid` followed by :meth:`consensus` with the messages received in
     that round; :meth:`consensus` closes the round and updates :attr:`unchanged_rounds`.
@@ -207,9 +209,9 @@ class CbaaAgent:
         self.unchanged_rounds = 0 if round_changed else self.unchanged_rounds + 1
         return changed
 
-    def message(self) -> CbaaMessage:
+    def message(self) -> CbbaMessage:
         """A copy of (y, z) to send to the neighbours."""
-        return CbaaMessage(self.y.copy(), self.z.copy())
+        return CbbaMessage(self.y.copy(), self.z.copy())
 
     def converged(self, diameter: int) -> bool:
         """Whether nothing changed for ``diameter + 1`` rounds (no news can still be on its way)."""
@@ -221,7 +223,7 @@ class CbaaAgent:
 
 
 @dataclass(frozen=True)
-class CbaaResult:
+class CbbaResult:
     """The outcome of :func:`run_synchronous`.
 
     Attributes:
@@ -238,13 +240,13 @@ class CbaaResult:
     rounds: int
     rounds_run: int
     assignment: Assignment
-    agents: tuple[CbaaAgent, ...]
+    agents: tuple[CbbaAgent, ...]
     diameter: int
     bound: int
 
 
 def scores_from_cost(cost: npt.ArrayLike, reward: float | None = None) -> FloatArray:
-    """The CBAA scores ``reward - cost``, ``-inf`` where the cost is ``inf``.
+    """The CBBA scores ``reward - cost``, ``-inf`` where the cost is ``inf``.
 
     Args:
         cost: (R, T) travel costs (m), ``inf`` where ineligible.
@@ -267,10 +269,10 @@ def scores_from_cost(cost: npt.ArrayLike, reward: float | None = None) -> FloatA
 
 
 def sequential_greedy_auction(scores: npt.ArrayLike) -> Assignment:
-    """SGA: the best remaining (robot, task) score first, repeated; CBAA's fixed point.
+    """SGA: the best remaining (robot, task) score first, repeated; CBBA's fixed point.
 
     Pairs are taken by decreasing score, equal scores by increasing robot then task index
-    (the tie rules of :class:`CbaaAgent`); ``nan``/``-inf`` pairs never.
+    (the tie rules of :class:`CbbaAgent`); ``nan``/``-inf`` pairs never.
     """
     s = np.asarray(scores, dtype=np.float64)
     return greedy_global(np.where(np.isfinite(s), -s, np.inf))
@@ -289,7 +291,7 @@ def graph_diameter(n_robots: int, edges: Iterable[tuple[int, int]]) -> tuple[lis
 
     Raises:
         ValueError: for an edge with an unknown robot or a self-loop, or a graph that is
-            not connected (CBAA then cannot agree across the parts).
+            not connected (CBBA then cannot agree across the parts).
     """
     adjacent: list[set[int]] = [set() for _ in range(n_robots)]
     for a, b in edges:
@@ -315,8 +317,8 @@ def run_synchronous(
     edges: Iterable[tuple[int, int]],
     *,
     reward: float | None = None,
-) -> CbaaResult:
-    """Run CBAA in lock-step rounds over a static undirected graph.
+) -> CbbaResult:
+    """Run CBBA in lock-step rounds over a static undirected graph.
 
     In every round, every agent bids; then every agent sends its message and merges those
     of its neighbours, all messages being taken after the bids and before any merge (the
@@ -340,14 +342,14 @@ def run_synchronous(
     scores = scores_from_cost(cost, reward)
     n_robots, n_tasks = scores.shape
     neighbours, diameter = graph_diameter(n_robots, edges)
-    agents = tuple(CbaaAgent(i, scores[i], n_robots) for i in range(n_robots))
+    agents = tuple(CbbaAgent(i, scores[i], n_robots) for i in range(n_robots))
     hops = max(diameter, 1)
     cap = (int(np.isfinite(scores).sum()) + 1) * hops + diameter + 1
     last_change = 0
     rounds_run = 0
     while not all(agent.converged(diameter) for agent in agents):
         if rounds_run >= cap:
-            raise RuntimeError(f"CBAA did not settle within {cap} rounds ({n_robots}x{n_tasks})")
+            raise RuntimeError(f"CBBA did not settle within {cap} rounds ({n_robots}x{n_tasks})")
         rounds_run += 1
         for agent in agents:
             agent.bid()
@@ -357,7 +359,7 @@ def run_synchronous(
         if any(agent.unchanged_rounds == 0 for agent in agents):
             last_change = rounds_run
     assignment = {agent.robot: agent.x for agent in agents if agent.x is not None}
-    return CbaaResult(
+    return CbbaResult(
         rounds=last_change,
         rounds_run=rounds_run,
         assignment=assignment,

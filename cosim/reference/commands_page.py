@@ -23,7 +23,7 @@ def commands_markdown() -> str:
         "`cosim COMMAND ...`; every command answers `--help`. Exit status: 0 done; 2 "
         "invalid input (one line on standard error naming the file, the key, the value and "
         "what was expected, no traceback); 1 an internal failure (a bug). This page is "
-        "generated from the command line's own parser (`cosim/reference/commands.py`).",
+        "generated from the command line's own parser (`cosim/reference/commands_page.py`).",
         "",
         "```text",
         parser.format_help().rstrip(),
