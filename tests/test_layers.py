@@ -205,7 +205,7 @@ def test_the_cycle_check_finds_a_loop_and_a_loop_through_three():
 def test_unity_lives_in_one_place():
     shell = [p for p in _modules("cosim") if "unity" in p.stem]
     assert shell == [], "Unity belongs to adapters/unity/"
-    assert {p.stem for p in _modules("adapters", "unity")} >= {"server", "poses", "inbound"}
+    assert {p.stem for p in _modules("adapters", "unity")} >= {"server", "pose_source", "inbound"}
 
 
 def test_the_rules_see_every_floor():
