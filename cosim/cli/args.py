@@ -11,7 +11,7 @@ import math
 from pathlib import Path
 from typing import NoReturn
 
-from adapters.physical.standin import add_arguments as add_standin_arguments
+from adapters.physical.standin_options import add_arguments as add_standin_arguments
 from cosim.cli.hostname import host_argument
 from cosim.scenario.fields import key_bounds
 from cosim.scenario.sections import ScenarioSection

@@ -12,7 +12,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from adapters.physical.standin import StandinOptions, main, run_standin
+from adapters.physical.standin import main, run_standin
+from adapters.physical.standin_options import StandinOptions
 from adapters.ros2dds.participant import RosParticipant
 from adapters.ros2dds.qos import QosKind
 from adapters.ros2dds.types import (
@@ -198,7 +199,7 @@ def test_the_command_line_prints_a_one_line_summary_after_a_run(capsys, domain):
 def test_any_standin_options_build_or_fail_with_a_config_error(name, domain, rate, speed, noise):
     import argparse
 
-    from adapters.physical.standin import FLOAT_OPTIONS, options_from
+    from adapters.physical.standin_options import FLOAT_OPTIONS, options_from
 
     values = {key: 0.0 for key in FLOAT_OPTIONS}
     values.update(rate_hz=rate, max_speed_mps=speed, noise_std_m=noise)
