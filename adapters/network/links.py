@@ -149,6 +149,14 @@ class LinksBackend(ModelLink):
 
     name: ClassVar[str] = "links"
     tables: ClassVar[tuple[TableSpec, ...]] = (LINKS,)
+    keys: ClassVar[tuple[str, ...]] = (
+        "topology", "edge_prob", "edges", "latency_model", "latency_ms", "jitter_ms",
+        "latency_csv", "reorder", "loss_model", "loss_prob", "ge_p", "ge_r", "ge_loss_bad",
+        "ge_loss_good", "bandwidth_mbps", "queue_packets", "range_m", "path_loss",
+        "path_loss_exponent", "tx_power_dbm", "ref_loss_db", "sensitivity_dbm", "shadowing_db",
+        "topology_update_hz", "partitions",
+    )  # fmt: skip
+    """The ``[network]`` keys only this backend reads (another backend leaves them unset)."""
 
     def __init__(self, context: NetworkContext) -> None:
         run, cfg = context.run, context.network

@@ -143,3 +143,48 @@ def test_the_example_study_gives_the_same_rows_on_two_local_workers_and_on_dask(
     )
     auction = rows[0][rows[0]["assignment.protocol"] == "sequential_auction"]
     assert (auction["tasks_completed"] > 0).all()
+
+
+def _summary(folder: Path) -> dict[str, object]:
+    return dict(json.loads((folder / "summary.json").read_text()))
+
+
+def test_a_loss_model_of_labkits_loses_exactly_every_nth_message_of_a_link(plugins, tmp_path):
+    done = cosim(plugins, "run", "warehouse-random", *SHORT, "--out", str(tmp_path / "run"),
+                 "--set", "network.loss_model='every_nth'", "--set", "every_nth.n=4")  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert _summary(tmp_path / "run")["loss_rate_configured"] == 0.25
+    messages = pd.read_parquet(tmp_path / "run" / "tables" / "messages.parquet")
+    remote = messages[messages["src_host"] != messages["dst_host"]].sort_values("t_sent_ns")
+    for (_src, _dst), copies in remote.groupby(["src_host", "dst_host"], observed=True):
+        lost = (copies["status"] == "lost").to_numpy()
+        assert lost.tolist() == [(k + 1) % 4 == 0 for k in range(len(lost))]
+
+
+def test_a_network_backend_of_labkits_replaces_the_links_model(plugins, tmp_path):
+    done = cosim(plugins, "run", "warehouse-random", *SHORT, "--out", str(tmp_path / "run"),
+                 "--set", "network.backend='wired'", "--set", "wired.max_ms=2.0")  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    summary = _summary(tmp_path / "run")
+    messages = pd.read_parquet(tmp_path / "run" / "tables" / "messages.parquet")
+    remote = messages[messages["src_host"] != messages["dst_host"]]
+    assert summary["wired_copies"] == len(remote) > 0 and set(remote["status"]) == {"delivered"}
+    delay = remote["t_recv_ns"] - remote["t_sent_ns"]
+    assert delay.min() >= 200_000 and delay.max() <= 2_000_000
+    assert "link_changes" not in summary  # the links backend did not run
+    refused = cosim(plugins, "check", "warehouse-random", "--set", "network.backend='wired'",
+                    "--set", "network.latency_ms=5.0")  # fmt: skip
+    assert refused.returncode == 2
+    assert "latency_ms = 5.0: expected 0 with backend 'wired' (only 'links' read" in refused.stderr
+
+
+def test_a_pose_source_of_labkits_tracks_every_robot_at_its_rate(plugins, tmp_path):
+    done = cosim(plugins, "run", "warehouse-random", *SHORT, "--out", str(tmp_path / "run"),
+                 "--set", "mocap.source='gnss'", "--set", "gnss.rate_hz=5.0")  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    summary = _summary(tmp_path / "run")
+    assert summary["gnss_fixes"] == 4 * 5 * 30  # 4 robots at 5 Hz for 30 s
+    # every fix went through the pose intake: accepted, or refused as a jump (2 cm noise on
+    # a robot at full speed may pass the jump tolerance)
+    taken = summary["mocap_poses"] + summary["mocap_rejected_jumps"]
+    assert taken == summary["gnss_fixes"] and summary["mocap_poses"] >= 0.95 * taken
