@@ -102,9 +102,8 @@ def _module_name(path: Path) -> str:
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
-MODULES = {
-    _module_name(p): p for p in _modules("cosim") + _modules("adapters") + _modules("models")
-}
+ALL = _modules("cosim") + _modules("adapters") + _modules("models")
+MODULES = {_module_name(p): p for p in ALL}
 
 
 def _resolve(name: str) -> str | None:
@@ -206,6 +205,54 @@ def test_unity_lives_in_one_place():
     shell = [p for p in _modules("cosim") if "unity" in p.stem]
     assert shell == [], "Unity belongs to adapters/unity/"
     assert {p.stem for p in _modules("adapters", "unity")} >= {"server", "pose_source", "inbound"}
+
+
+def _is_face(path: Path) -> bool:
+    """A package's ``__init__.py`` that only hands names on (or says what is inside)."""
+    tree = ast.parse(path.read_text())
+    return path.name == "__init__.py" and not any(
+        isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef)
+        for node in tree.body
+    )
+
+
+def _tested_by(test: Path, module: str) -> bool:
+    """Whether a test file imports ``module`` (or a name from it)."""
+    if not test.is_file():
+        return False
+    package, _, leaf = module.rpartition(".")
+    for node in ast.walk(ast.parse(test.read_text())):
+        if isinstance(node, ast.Import) and any(a.name == module for a in node.names):
+            return True
+        if isinstance(node, ast.ImportFrom) and node.module == module:
+            return True
+        if (
+            isinstance(node, ast.ImportFrom)
+            and node.module == package
+            and any(a.name == leaf for a in node.names)
+        ):
+            return True
+    return False
+
+
+def untested(path: Path) -> bool:
+    """Whether a source module has no test file: ``tests/<its path>/test_<name>.py``, or its
+    package's ``test_<package>.py`` importing it (``test_package.py`` for a package's own
+    ``__init__.py``)."""
+    folder = ROOT / "tests" / path.relative_to(ROOT).parent
+    if path.name == "__main__.py" or _is_face(path):
+        return False
+    if path.name == "__init__.py":
+        names = [f"test_{path.parent.name}.py", "test_package.py"]
+        return not any((folder / name).is_file() for name in names)
+    if (folder / f"test_{path.stem}.py").is_file():
+        return False
+    return not _tested_by(folder / f"test_{path.parent.name}.py", _module_name(path))
+
+
+def test_every_source_module_has_a_test_file():
+    missing = [_ids(p) for p in ALL if untested(p)]
+    assert missing == [], f"{len(missing)} modules without a test file: {missing}"
 
 
 def test_the_rules_see_every_floor():
