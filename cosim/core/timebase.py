@@ -37,8 +37,6 @@ def period_ns(rate_hz: float) -> int:
     """
     if rate_hz <= 0:
         raise ValueError(f"rate must be positive, got {rate_hz} Hz")
-    period = NS_PER_S / rate_hz
-    rounded = round(period)
-    if rounded <= 0:
+    if rate_hz > NS_PER_S:
         raise ValueError(f"rate {rate_hz} Hz is above 1 GHz")
-    return rounded
+    return round(NS_PER_S / rate_hz)

@@ -136,7 +136,8 @@ def flatten(kind: WireType, source: Source | None, names: Callable[[str], str]) 
         held = names("a")
         ops = [Let(held, code or "()")]
         for k in range(kind.length):
-            each = None if code is None else Expr(f"{held}[{k}]")
+            at = f"{held}[{k}]"
+            each = None if code is None else AsTuple(at) if _is_struct(element) else Expr(at)
             ops += flatten(element, each, names)
         return ops
     element = kind.element

@@ -217,25 +217,6 @@ def test_a_host_subscribing_while_a_broadcast_is_delivered_gets_it_if_it_arrives
     assert got == ["b", "c", "c late"]
 
 
-def test_the_recorder_codes_hosts_topics_and_statuses_as_plain_strings_in_order_of_arrival():
-    recorder = Recorder()
-    rows = [
-        (B, A, "/y", DeliveryStatus.LOST, None),
-        (A, C, "/x", DeliveryStatus.DELIVERED, 7),
-        (B, B, "/y", DeliveryStatus.DELIVERED, 3),
-    ]
-    for src, dst, topic, status, t_recv in rows:
-        recorder.on_transfer(1, t_recv, src, dst, topic, 10, status)
-    frame = messages_frame(recorder)
-    assert list(frame["src_host"]) == ["b", "a", "b"]
-    assert list(frame["dst_host"]) == ["a", "c", "b"]
-    assert list(frame["topic"]) == ["/y", "/x", "/y"]
-    assert list(frame["status"]) == ["lost", "delivered", "delivered"]
-    categories = list(frame["status"].cat.categories)
-    assert categories == ["lost", "delivered"]
-    assert all(type(c) is str for c in categories)
-
-
 def _traffic(batched: bool) -> tuple[list[tuple[int, str, str, Envelope]], list[str], object]:
     """Three topics from three hosts, local and remote subscribers, a monitor and a drop."""
     kernel = Kernel()
@@ -296,52 +277,6 @@ def test_publishing_many_with_unmatched_lists_is_refused_before_anything_is_sent
     assert got == [] and bus.published == 0 and sum(recorder.counts.values()) == 0
 
 
-def _recorded(batched: bool) -> Recorder:
-    """Broadcasts, a lost copy, a local delivery; chunks of 2 rows cut through broadcasts."""
-    d, g, h, z = HostId("d"), HostId("g"), HostId("h"), HostId("z")
-    sends = [
-        (
-            A,
-            "/x",
-            [Transfer(z, DeliveryStatus.DELIVERED, 5), Transfer(B, DeliveryStatus.LOST, None)],
-        ),
-        (A, "/y", [Transfer(d, DeliveryStatus.DELIVERED, 6)]),
-        (
-            C,
-            "/x",
-            [Transfer(A, DeliveryStatus.DELIVERED, 7), Transfer(g, DeliveryStatus.DELIVERED, 9)],
-        ),
-        (h, "/z", [Transfer(h, DeliveryStatus.DELIVERED, 3)]),  # h first as a source
-        (z, "/y", [Transfer(A, DeliveryStatus.QUEUE_FULL, None)] * 3),
-    ]
-    recorder = Recorder()
-    for k, (src, topic, transfers) in enumerate(sends):
-        if batched:
-            recorder.on_transmission(k, src, topic, 10 + k, transfers)
-        else:
-            for t in transfers:
-                recorder.on_transfer(k, t.t_recv_ns, src, t.dst, topic, 10 + k, t.status)
-    return recorder
-
-
-def test_a_transmission_recorded_at_once_gives_the_rows_codes_and_counts_of_each_in_turn(
-    monkeypatch,
-):
-    """Hosts are coded per chunk, sources first: the chunks must be cut where they were.
-
-    Rows 4 and 5 share a chunk: h (source of row 5) is coded before g (destination of row 4).
-    """
-    monkeypatch.setattr("cosim.core.recorder._FLUSH_ROWS", 2)
-    batched, one_by_one = _recorded(batched=True), _recorded(batched=False)
-    frame, expected = messages_frame(batched), messages_frame(one_by_one)
-    pd.testing.assert_frame_equal(frame, expected)
-    hosts = list(frame["src_host"].cat.categories)
-    assert hosts == list(expected["src_host"].cat.categories) == ["a", "z", "b", "c", "d", "h", "g"]
-    assert len(frame) == 9 and batched.counts == one_by_one.counts
-    assert (batched.network_messages, batched.network_bytes) == (8, 97)
-    assert (one_by_one.network_messages, one_by_one.network_bytes) == (8, 97)
-
-
 class SameTimeLink:
     """A test link delivering every copy ``delay_ns`` after sending: as one outcome or each."""
 
@@ -393,24 +328,3 @@ def test_a_link_delivering_every_copy_at_once_delivers_and_records_as_copy_by_co
 def test_a_link_delivering_before_sending_is_refused_either_way(all_at_once):
     with pytest.raises(ValueError, match="before it was sent"):
         _broadcasts(all_at_once, delay_ns=-1)
-
-
-def test_a_transmission_delivered_at_once_is_recorded_as_its_transfers(monkeypatch):
-    monkeypatch.setattr("cosim.core.recorder._FLUSH_ROWS", 2)
-    a, b = Recorder(), Recorder()
-    sends = [(A, "/x", (B, C), 5), (C, "/y", (A,), 7), (B, "/x", (B, A, C), 9)]
-    for k, (src, topic, dsts, t_recv) in enumerate(sends):
-        a.on_all_delivered(k, src, topic, 10 + k, dsts, t_recv)
-        b.on_transmission(
-            k, src, topic, 10 + k, [Transfer(d, DeliveryStatus.DELIVERED, t_recv) for d in dsts]
-        )
-    pd.testing.assert_frame_equal(messages_frame(a), messages_frame(b))
-    assert a.counts == b.counts and len(messages_frame(a)) == 6
-    assert (
-        (a.network_messages, a.network_bytes)
-        == (b.network_messages, b.network_bytes)
-        == (
-            5,
-            10 * 2 + 11 + 12 * 2,
-        )
-    )
