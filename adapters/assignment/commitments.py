@@ -112,9 +112,9 @@ class Commitments:
             if not self.preemption:
                 return
             self._release(run, robot, "re-assigned")
-        if task is None:
-            if robot.phase == "heading":
+            if task is None:  # re-assigned to nothing: stop driving to the task given up
                 self._cancel(run, robot)
+        if task is None:
             return
         x, y = self.pose[robot.index]
         self._take(run, robot, task, self.cost(x, y, task))

@@ -111,13 +111,6 @@ def test_robots_recognise_their_loops_in_a_run_as_far_as_their_settings_search(t
     assert closed.summary["map_ate_m"] <= closed.summary["map_ate_odom_m"] / 3
 
 
-def test_loop_closure_with_shared_map_updates_is_refused_naming_the_keys():
-    with pytest.raises(cosim.ConfigError, match=r"\[mapping\] loop_closure = true: expected false"):
-        cosim.load_scenario(
-            "warehouse-mapping", overrides={"mapping.loop_closure": True, "mapping.share": "maps"}
-        )
-
-
 @pytest.mark.slow
 def test_with_a_robots_layer_the_other_robots_stay_out_of_the_maps():
     from adapters.world.warehouse import scenario_warehouse

@@ -4,7 +4,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from adapters.mocap.tracking import tracked_bodies, tracked_robots
+from adapters.mocap.tracking import tracked_robots
 from adapters.physical.bridge import physical_robots
 from cosim import load_scenario
 from cosim.core.errors import ConfigError
@@ -49,25 +49,6 @@ def test_a_robot_tracked_twice_is_refused():
         )
 
 
-def test_simulated_mocap_tracks_every_robot_unless_told_which():
-    assert tracked_robots(scenario(**{"mocap.source": "simulated"}), NAMES) == NAMES
-    s = scenario(**{"mocap.source": "simulated", "mocap.robots": ["robot_2"]})
-    assert tracked_robots(s, NAMES) == ["robot_2"]
-
-
-def test_a_ros2_source_tracks_each_physical_robot_on_the_topic_pattern():
-    s = scenario(
-        **{
-            "mocap.source": "ros2",
-            "mocap.topic_pattern": "/vicon/{robot}/{robot}",
-            "physical.robots": ["robot_2"],
-        }
-    )
-    assert tracked_bodies(s, NAMES) == [("robot_2", "/vicon/robot_2/robot_2")]
-    assert physical_robots(s, NAMES) == ["robot_2"]
-    assert tracked_robots(s, NAMES) == ["robot_2"]
-
-
 def test_a_physical_robot_without_a_live_pose_is_refused():
     s = scenario(**{"physical.robots": ["robot_1"]})
     with pytest.raises(ConfigError, match=r"physical.pose = 'odom'"):
@@ -78,11 +59,6 @@ def test_a_physical_robot_that_is_not_in_the_fleet_is_named():
     s = scenario(**{"physical.robots": ["robot_9"], "physical.pose": "odom"})
     with pytest.raises(ConfigError, match=r"\[physical\] robots names 'robot_9'"):
         physical_robots(s, NAMES)
-
-
-def test_a_physical_robot_reporting_its_own_odometry_localizes_by_it():
-    s = scenario(**{"physical.robots": ["robot_3"], "physical.pose": "odom"})
-    assert tracked_robots(s, NAMES) == ["robot_3"]
 
 
 def test_a_dds_domain_beyond_232_is_refused():
