@@ -73,7 +73,7 @@ def test_the_section_comes_after_the_networks():
     assert NavigationConfig.ORDER > NetworkConfig.ORDER
 
 
-@settings(max_examples=100, deadline=None)
+@settings(max_examples=60, deadline=None)
 @given(
     st.sampled_from(
         ["replan_hz", "control_hz", "lookahead_m", "stuck_timeout_s", "robots_layer_hz", "traffic"]

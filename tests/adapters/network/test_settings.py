@@ -165,7 +165,7 @@ VALUES = st.one_of(
 )
 
 
-@settings(max_examples=150, deadline=None)
+@settings(max_examples=80, deadline=None)
 @given(key=KEYS, value=VALUES)
 def test_any_network_value_is_accepted_or_refused_in_one_line_naming_the_key(key, value):
     try:

@@ -83,7 +83,7 @@ def test_a_bad_value_is_refused_in_one_line_naming_the_key(key, value):
     assert f"physical.{key}" in message and "\n" not in message
 
 
-@settings(max_examples=100, deadline=None)
+@settings(max_examples=60, deadline=None)
 @given(
     st.sampled_from(["robots", "dds_domain", "interface", "pose_timeout_s", "poll_hz", "drive"]),
     st.one_of(

@@ -52,7 +52,7 @@ def test_a_value_out_of_bounds_is_refused_naming_the_key_and_the_bound(key, valu
     assert f"tasks.{key}" in message and expected in message and "\n" not in message
 
 
-@settings(max_examples=100, deadline=None)
+@settings(max_examples=60, deadline=None)
 @given(st.integers(-3, 200), st.integers(-3, 200))
 def test_any_initial_and_cap_are_accepted_exactly_when_the_cap_can_be_reached(initial, cap):
     try:

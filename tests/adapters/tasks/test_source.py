@@ -91,6 +91,15 @@ def _holders(task_set: TaskSet) -> dict[int, str]:
     return {t.task_id: t.holder for t in task_set.tasks}
 
 
+def test_the_tasks_table_declares_its_columns_with_units_in_map_and_seconds():
+    assert TASKS_TABLE.name == "tasks" and TaskSourceAdapter.tables == (TASKS_TABLE,)
+    assert "(m)" in TASKS_TABLE.columns["x_m"] and "map" in TASKS_TABLE.columns["x_m"]
+    for column in TASK_COLUMNS:
+        if column.startswith("t_"):
+            assert column.endswith("_s") and "(s)" in TASKS_TABLE.columns[column], column
+    assert set(TASKS_TABLE.categorical) <= set(TASKS_TABLE.columns) and not TASKS_TABLE.volatile
+
+
 def test_the_first_tasks_are_opened_at_distinct_free_pick_stations_and_announced_at_once():
     s = Source()
     s.start()
