@@ -117,13 +117,12 @@ def _planar_pose(topic: str, data: bytes) -> tuple[float, float, float]:
     quaternion = tuple(float(c) for c in q)
     if not all(math.isfinite(c) for c in quaternion):
         raise ValueError(f"{topic}: orientation {quaternion}; expected finite")
-    qx, qy, qz, qw = quaternion
-    yaw = (
-        math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
-        if any(quaternion)
-        else math.nan
-    )
-    return x, y, yaw
+    norm = math.hypot(*quaternion)
+    if norm == 0.0:
+        return x, y, math.nan
+    # normalized first: the products of a very large or very small one overflow or vanish
+    qx, qy, qz, qw = (c / norm for c in quaternion)
+    return x, y, math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
 
 
 @dataclass(frozen=True, slots=True)

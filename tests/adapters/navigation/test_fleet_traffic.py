@@ -1,18 +1,12 @@
 """``navigation.traffic = "pibt"``: the fleet manager moving robots place by place."""
 
-import re
-
 import numpy as np
 import pytest
-from hypothesis import given, settings
-from hypothesis import strategies as st
 
 import adapters.navigation.fleet_traffic as fleet_traffic
 import cosim
 from adapters.navigation.fleet_traffic import FleetTraffic
 from adapters.navigation.places import CLEARANCE_M, MOVE, STAND, FleetPlaces
-from cosim.runner.assembly import check_scenario
-from models.errors import ModelError
 from models.geometry.occupancy import OccupancyGrid
 from models.navigation.costmap import CostmapParams, StaticCostmap
 from models.navigation.lanes import TWO_WAY
@@ -68,37 +62,6 @@ def test_the_same_seed_gives_the_same_tables_with_places():
     second = cosim.run(_pibt_fleet(8, 20.0)).deterministic_tables()
     for name, frame in first.items():
         assert second[name].equals(frame), name
-
-
-def test_a_fleet_with_more_robots_than_places_is_refused_naming_the_key():
-    occupancy = np.zeros((30, 30), dtype=np.int8)  # 3 m x 3 m
-    occupancy[0, :] = occupancy[-1, :] = occupancy[:, 0] = occupancy[:, -1] = 100
-    static = StaticCostmap.from_grid(OccupancyGrid(0.1, (0.0, 0.0), occupancy), CostmapParams(0.33))
-    lanes = np.full(static.cost.shape, TWO_WAY, dtype=np.uint8)
-    positions = np.full((20, 2), 1.5)
-    with pytest.raises(ModelError, match=r"robots\.count"):
-        FleetTraffic(FleetPlaces(static, lanes, positions, 0.33))
-
-
-@pytest.mark.parametrize(
-    ("override", "named"),
-    [
-        ({"mapping.enabled": True}, r"\[mapping\] enabled = true"),
-        ({"odometry.drift": 0.02}, r"\[odometry\] drift = 0.02"),
-        (
-            {"mapping.enabled": True, "mocap.source": "simulated", "mocap.robots": ["robot_1"]},
-            "3 of 4",
-        ),
-    ],
-)
-def test_the_fleet_manager_refuses_robots_that_cannot_localize_to_within_its_gap(override, named):
-    scenario = cosim.load_scenario("fleet50", {**override, "robots.count": 4})
-    with pytest.raises(cosim.ConfigError) as refused:
-        cosim.run(scenario.with_duration(1.0))
-    message = str(refused.value)
-    assert "preset fleet50: [navigation] traffic = 'pibt'" in message
-    assert re.search(named, message), message
-    assert "navigation.traffic = 'none'" in message and "mocap.source = 'simulated'" in message
 
 
 @pytest.mark.slow
@@ -233,31 +196,3 @@ def test_a_robot_that_let_another_through_off_its_goals_place_keeps_its_places_c
     traffic.step(poses, np.array([True, True]), np.zeros(2, dtype=np.int64), 1)
     assert traffic.places.node[0] == p  # back to its goal's place
     assert (traffic.places.node[1] != east) == returning  # kept for robot 0's approach
-
-
-@settings(max_examples=60, deadline=None)
-@given(
-    traffic=st.sampled_from(["none", "lanes", "pibt"]),
-    mapping=st.booleans(),
-    drift=st.one_of(st.just(0.0), st.floats(0.0, 1.0)),
-    tracked=st.one_of(st.none(), st.lists(st.integers(1, 4), unique=True)),
-)
-def test_the_fleet_manager_is_refused_exactly_when_an_untracked_robot_localizes_badly(
-    traffic, mapping, drift, tracked
-):
-    overrides = {
-        "navigation.traffic": traffic,
-        "mapping.enabled": mapping,
-        "odometry.drift": drift,
-        "robots.count": 4,
-    }
-    if tracked is not None:  # tracked by simulated motion capture ([] = every robot)
-        overrides |= {"mocap.source": "simulated", "mocap.robots": [f"robot_{i}" for i in tracked]}
-    scenario = cosim.load_scenario("fleet50", overrides)
-    everyone = tracked is not None and len(tracked) in (0, 4)
-    refused = traffic == "pibt" and not everyone and (mapping or drift > 0)
-    if not refused:
-        check_scenario(scenario)
-        return
-    with pytest.raises(cosim.ConfigError, match=r"\[navigation\] traffic = 'pibt' with \["):
-        check_scenario(scenario)

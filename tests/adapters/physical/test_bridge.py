@@ -14,12 +14,11 @@ from cyclonedds.idl.annotations import final
 import cosim
 from adapters.physical.bridge import SilentRobotError
 from adapters.physical.domain import claim_run_domain
-from adapters.physical.launcher import Standins, standin_command
+from adapters.physical.launcher import Standins
 from adapters.ros2dds.participant import RosParticipant
 from adapters.ros2dds.qos import QosKind
 from adapters.ros2dds.types import Header, Odometry, Point, Pose, PoseWithCovariance, Quaternion
 from adapters.ros2dds.types import stamp as ros_stamp
-from cosim.core.errors import ConfigError
 from cosim.runner.execute import execute
 from tests.conftest import cosim_main
 
@@ -122,31 +121,6 @@ def test_samples_that_are_not_poses_jumps_and_foreign_writers_are_counted_not_us
     twin = poses[poses.robot == "robot_1"]
     assert twin.y_m.max() < 1.01  # no jump ever reached the twin
     assert twin.x_m.iloc[-1] > 1.0 + 0.002 * 50  # it followed the good samples
-
-
-def test_standins_need_a_physical_robot_in_the_scenario():
-    with pytest.raises(ConfigError, match="no physical robot"):
-        Standins(cosim.load_scenario("lab-room"))
-
-
-def test_standins_of_an_auto_domain_claim_one_and_tell_it_each_standin():
-    standins = Standins(cosim.load_scenario("lab-real-in-virtual"))
-    try:
-        assert standins.domain is not None
-        domain = standins.domain.claim.domain
-        assert standins.scenario.physical.dds_domain == domain
-        command = standin_command(standins.scenario, "robot_1", 1)
-        assert command[command.index("--domain") + 1] == str(domain)
-    finally:
-        standins.stop()  # gives the domain back
-    again = claim_run_domain(cosim.load_scenario("lab-real-in-virtual"))
-    assert again is not None and again.claim.domain <= domain
-    again.close()
-
-
-def test_a_standin_command_needs_the_runs_claimed_domain():
-    with pytest.raises(ConfigError, match="dds_domain = 'auto': expected the run's claimed"):
-        standin_command(cosim.load_scenario("lab-real-in-virtual"), "robot_1", 1)
 
 
 @pytest.mark.slow
