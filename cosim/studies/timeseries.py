@@ -34,7 +34,7 @@ from cosim.studies.panels import (
 def series_frame(
     study_dir: Path, table: str, y: str, where: Mapping[str, Any], keys: Sequence[str]
 ) -> pd.DataFrame:
-    """Rows ``t_s``, ``y`` and the run's ``keys`` (x, hue, facet) of every ok run's table."""
+    """Rows ``t_s``, ``y``, ``run_id``, ``seed`` and the ``keys`` (x, hue, facet) of ok runs."""
     results = load_results(study_dir)
     ok = results[results["status"] == "ok"]
     frames = []
@@ -48,6 +48,7 @@ def series_frame(
         for column, value in where.items():
             frame = frame[frame[column].astype(str) == str(value)]
         part = frame[["t_s", y]].copy()
+        part["run_id"] = row["run_id"]
         part["seed"] = row["seed"]
         for key in keys:
             part[key] = row[key]
@@ -125,7 +126,7 @@ def _draw(
         axes[min(len(facets), PANELS_PER_ROW) - 1].legend(
             title=short_label(hue), fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0)
         )
-    runs = data.groupby([c for c in ("seed", facet, hue) if c], dropna=False).ngroups
+    runs = data["run_id"].nunique()  # runs may differ in keys the figure does not split on
     one_each = len(data) == runs * data["t_s"].nunique()  # a value per run and time
     unit = "seeds" if one_each else f"values ({runs} runs)"
     note = band_caption(table["n"].to_numpy(int), unit=unit, dots=False)

@@ -1,6 +1,8 @@
 import shutil
 from pathlib import Path
+from types import SimpleNamespace
 
+import numpy as np
 import pandas as pd
 import pytest
 from PIL import Image
@@ -81,6 +83,16 @@ def test_snapshot_times_default_to_four_evenly_spaced_times_within_the_run(task_
     run = load_run(task_run)
     assert snapshot_times(run, None) == [5.0, 10.0, 15.0, float(run.track.t_s[-1])]
     assert snapshot_times(run, [0, 7.5]) == [0.0, 7.5]
+
+
+def test_the_default_snapshots_of_the_paper_scenario_3_include_t_25_s() -> None:
+    scenario = cosim.load_scenario("lab-mixed")
+    run = SimpleNamespace(
+        scenario=scenario, track=SimpleNamespace(t_s=np.arange(0.0, 59.95, 0.1)), path=Path(".")
+    )
+    times = snapshot_times(run, None)  # type: ignore[arg-type]
+    assert 25.0 in times
+    assert times == sorted(times) and max(times) <= 59.9 + 1e-9
 
 
 @pytest.mark.parametrize("at", [[99.0], [-1.0], [float("nan")], ["soon"]])

@@ -1,10 +1,6 @@
-import json
-
 import numpy as np
 import pandas as pd
-import pytest
 
-from cosim.plotting.assignment import epoch_stats
 from cosim.plotting.rundata import load_run, robot_order
 
 
@@ -46,13 +42,3 @@ def test_tables_the_run_lacks_or_that_are_empty_are_none(waypoint_run):
     run = load_run(waypoint_run)
     assert run.tasks is None and run.assignments is None
     assert run.messages is not None
-
-
-def test_decided_epochs_take_as_long_as_the_run_summary_says(task_run):
-    stats = epoch_stats(load_run(task_run))
-    summary = json.loads((task_run / "summary.json").read_text())
-    assert stats.announced
-    assert stats.decided.any()
-    mean = stats.decision_s[stats.decided].mean()
-    assert mean == pytest.approx(summary["mean_convergence_time_s"], abs=1e-6)
-    assert (stats.rounds >= 1).all() and (stats.messages >= 1).all()

@@ -1,6 +1,5 @@
 """The study runner: validation, executors (local and a real Dask cluster), resume."""
 
-import io
 import signal
 import subprocess
 import sys
@@ -14,7 +13,6 @@ import pytest
 import cosim
 from cosim.core.errors import ConfigError
 from cosim.studies import load_study, run_study
-from cosim.studies.runner import Progress
 from cosim.studies.worker import VOLATILE_METRICS, Outcome
 from tests.conftest import REPO, cosim_main
 from tests.dask_cluster import dask_cluster as start_dask_cluster
@@ -309,39 +307,6 @@ def test_a_report_with_heatmaps_draws_one_per_metric_and_links_it(tmp_path):
     name = "tasks_per_min_over_network.latency_ms_and_assignment.protocol.png"
     assert (tmp_path / "out" / "figures" / name).stat().st_size > 10_000
     assert f"(figures/{name})" in (tmp_path / "out" / "report.md").read_text()
-
-
-class _Terminal(io.StringIO):
-    def isatty(self) -> bool:
-        return True
-
-
-def _outcome(status: str) -> Outcome:
-    return Outcome(row={"run_id": "r", "status": status}, summary={}, scenario_toml="", tables={})
-
-
-def test_the_progress_bar_counts_resumed_runs_and_failures_and_ends_the_line():
-    terminal = _Terminal()
-    progress = Progress(terminal)
-    progress.begin(total=4, already_done=2)
-    progress(_outcome("ok"))
-    progress(_outcome("error"))
-    text = terminal.getvalue()
-    assert "resuming, 2/4 runs already done" in text
-    assert "[##################------] 3/4 runs, 0 failed" in text
-    assert "[########################] 4/4 runs, 1 failed" in text
-    assert text.endswith("\n")
-
-
-def test_progress_on_a_pipe_writes_a_line_per_tenth_of_the_study():
-    pipe = io.StringIO()
-    progress = Progress(pipe)
-    progress.begin(total=100, already_done=0)
-    for _ in range(100):
-        progress(_outcome("ok"))
-    lines = pipe.getvalue().splitlines()
-    assert len(lines) == 11  # the first run, then every tenth
-    assert lines[-1].startswith("study: 100/100 runs, 0 failed")
 
 
 SHIPPED = sorted((REPO / "studies").glob("*.toml"))
