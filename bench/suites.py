@@ -18,6 +18,7 @@ from network_bench import network_deliveries_per_second
 from planner_bench import planner_ms
 from recording_bench import bag_cost, bag_memory_1h, encoding
 from scale_bench import fleet_scaling
+from startup_bench import cli_startup
 from study_bench import study_throughput_200
 
 import cosim
@@ -432,4 +433,5 @@ SUITES: dict[str, Callable[[int], Result]] = {
     "fleet50_mapping": fleet50_mapping,
     "recordings_mapping": recordings_mapping,
     "humans_coupling": humans_coupling,
+    "cli_startup": cli_startup,
 }

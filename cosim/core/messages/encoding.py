@@ -21,6 +21,7 @@ Decoding is :mod:`cosim.core.messages.decoding`'s.
 from __future__ import annotations
 
 import math
+import re
 import struct as _struct
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -309,6 +310,44 @@ def _entry(mod: int, res: int, body: list[Op]) -> tuple[int, int]:
     return 1, 0
 
 
+_ASSIGN = re.compile(r"^    [\w, ]+ = ")
+_USES_N = re.compile(r"\bn\b")
+
+
+def _encoder(lines: list[str]) -> list[str]:
+    """The encoder's code: one ``b"".join`` where every piece is laid out in advance.
+
+    Where a piece's padding depends on how long the bytes are so far (``len(b)``) or a
+    loop writes them, the bytes grow in a ``bytearray`` instead.
+    """
+    pieces, steps = ["_HEADER"], []
+    for line in lines:
+        if line.startswith("    b += ") and "len(b)" not in line:
+            pieces.append(line.removeprefix("    b += "))
+        elif _ASSIGN.match(line) and "len(b)" not in line and not line.startswith("     "):
+            steps.append(line)
+        else:
+            return ["def encode(m):", "    b = bytearray(_HEADER)", *lines, "    return bytes(b)"]
+    return ["def encode(m):", *steps, f"    return b''.join(({', '.join(pieces)},))"]
+
+
+def _sizer(lines: list[str]) -> list[str]:
+    """The size function's code: one sum where no term needs the size so far."""
+    fixed, terms, steps = 4, [], []
+    for line in lines:
+        if line.startswith("    n += ") and not _USES_N.search(line.removeprefix("    n += ")):
+            term = line.removeprefix("    n += ")
+            if term.isdigit():
+                fixed += int(term)
+            else:
+                terms.append(term)
+        elif _ASSIGN.match(line) and not line.startswith("     ") and not _USES_N.search(line):
+            steps.append(line)
+        else:
+            return ["def size(m):", "    n = 0", *lines, "    return n + 4"]
+    return ["def size(m):", *steps, f"    return {' + '.join([str(fixed), *terms])}"]
+
+
 @dataclass(frozen=True)
 class Compiled:
     """A message class's encoder and size function.
@@ -345,19 +384,6 @@ def compile_encoder(kind: Struct, source: Source, helpers: Mapping[str, Any]) ->
     out = _Code(namespace)
     _emit(out, flatten(kind, source, out.name))
     out.flush()
-    text = "\n".join(
-        [
-            "def encode(m):",
-            "    b = bytearray(_HEADER)",
-            *out.enc,
-            "    return bytes(b)",
-            "",
-            "def size(m):",
-            "    n = 0",
-            *out.size,
-            "    return n + 4",
-            "",
-        ]
-    )
+    text = "\n".join([*_encoder(out.enc), "", *_sizer(out.size), ""])
     exec(compile(text, f"<cdr {kind.ros_type}>", "exec"), namespace)
     return Compiled(namespace["encode"], namespace["size"], text)
