@@ -12,6 +12,7 @@ import json
 import os
 import platform
 import statistics
+import subprocess
 import sys
 import time
 from collections.abc import Callable
@@ -34,6 +35,23 @@ def machine() -> dict[str, Any]:
     }
 
 
+def commit() -> str:
+    """The measured code's commit (``+changes`` when the work tree differs from it)."""
+    try:
+        head = subprocess.run(
+            ["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=True
+        ).stdout.strip()
+        dirty = subprocess.run(
+            ["git", "status", "--porcelain", "--untracked-files=no"],
+            capture_output=True,
+            text=True,
+            check=True,
+        ).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+    return head + ("+changes" if dirty else "")
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=Path("bench/results.json"))
@@ -44,6 +62,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.out.exists():
         previous = json.loads(args.out.read_text()).get("benchmarks", {})
     results = dict(previous)
+    code = commit()
     for name in args.only or sorted(SUITES):
         suite: Callable[[int], Result] = SUITES[name]
         print(f"bench {name} ...", flush=True)
@@ -51,6 +70,7 @@ def main(argv: list[str] | None = None) -> int:
         result = suite(args.repeat)
         result["bench_wall_s"] = round(time.perf_counter() - start, 2)
         result["measured"] = time.strftime("%Y-%m-%d %H:%M:%S")
+        result["commit"] = code
         results[name] = result
         print(json.dumps(result, indent=2), flush=True)
     args.out.parent.mkdir(parents=True, exist_ok=True)
