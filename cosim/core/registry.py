@@ -27,6 +27,7 @@ from importlib.metadata import entry_points
 from typing import Any, Generic, TypeVar
 
 from cosim.core.errors import RegistryError
+from cosim.core.plugins import KINDS, note_given
 
 T = TypeVar("T")
 
@@ -63,6 +64,9 @@ class Group:
     chosen_by: str
     named: bool = True
     check: Check | None = None
+
+    def __post_init__(self) -> None:
+        KINDS[self.entry_points] = self.words
 
     def installed(self) -> Registry[Any]:
         """The entries installed packages register in this group (names only, no import).
@@ -193,6 +197,7 @@ class Registry(Generic[T]):
 
     def with_entry(self, name: str, entry: T) -> Registry[T]:
         """A copy with ``entry`` registered as ``name`` (for tests and ``cosim.run``)."""
+        note_given(entry, self.group.entry_points, name)
         copy = Registry(self.group, {**self._entries, name: entry})
         copy._loaded = {k: v for k, v in self._loaded.items() if k != name}
         return copy
@@ -312,6 +317,7 @@ class AdapterRegistry(Registry[Any]):
 
     def with_adapter(self, adapter: Any) -> AdapterRegistry:
         """A copy of this registry with ``adapter`` added under its own ``name``."""
+        note_given(adapter, self.group.entry_points, adapter.name)
         copy = AdapterRegistry({**self._entries, adapter.name: adapter})
         copy._loaded = {k: v for k, v in self._loaded.items() if k != adapter.name}
         return copy

@@ -1,5 +1,6 @@
-"""ROS 2's standard message types, declared once (their Humble definitions; Jazzy's differ
-only in ``sensor_msgs/msg/Range``, which appends ``variance``).
+"""ROS 2's standard message types, declared once (their Humble definitions).
+
+Jazzy's differ only in ``sensor_msgs/msg/Range``, which appends ``variance``.
 
 The bus, the bags and DDS share these declarations: a bus message of a standard type binds
 its fields onto one of them (:func:`cosim.core.messages.declare.message`'s ``wire``), a bag
