@@ -19,8 +19,9 @@ and the nearest ones.
 
 from __future__ import annotations
 
+import contextlib
 import difflib
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from functools import cache
 from importlib.metadata import entry_points
@@ -74,7 +75,7 @@ class Group:
         Entries of cosim itself come first, in declaration order; then other packages' by
         package name.
         """
-        return Registry(self, _entry_points(self.entry_points))
+        return Registry(self, {**_entry_points(self.entry_points), **_given(self.entry_points)})
 
 
 def installed_groups() -> list[Group]:
@@ -288,6 +289,46 @@ def suggest_names(name: str, names: Iterable[str]) -> str:
     return f"{hint} (registered: {', '.join(options) or 'none'})"
 
 
+_GIVEN: dict[str, dict[str, Any]] = {}
+"""Entries registered in code (:func:`registered`), by group, then name."""
+
+
+def _given(group: str) -> dict[str, Any]:
+    return _GIVEN.get(group, {})
+
+
+@contextlib.contextmanager
+def registered(entry_points: str, name: str, entry: Any) -> Iterator[None]:
+    """While inside, ``entry`` is registered as ``name`` in ``entry_points``, given in code.
+
+    As if an installed package declared it (a test's protocol, a script's adapter, a
+    settings section): every registry of the group lists it, and its errors name it as
+    code given in a script or test.
+
+    ```python
+    with registered("cosim.protocols", "my_auction", MyAuction):
+        cosim.run(cosim.load_scenario("warehouse-rows", {"assignment.protocol": "my_auction"}))
+    ```
+
+    Raises:
+        RegistryError: ``name`` is registered in the group already.
+    """
+    taken = {**_entry_points(entry_points), **_given(entry_points)}
+    if name in taken:
+        owner = taken[name]
+        where = owner.package if isinstance(owner, Lazy) else "code given earlier"
+        raise RegistryError(
+            f"{name!r} is registered in {entry_points} already (by {where}); "
+            "choose another name for the entry given in code"
+        )
+    note_given(entry, entry_points, name)
+    _GIVEN.setdefault(entry_points, {})[name] = entry
+    try:
+        yield
+    finally:
+        _GIVEN[entry_points].pop(name, None)
+
+
 @cache
 def _entry_points(group: str) -> dict[str, Lazy]:
     """A group's entry points, cosim's first, then other packages' by package name."""
@@ -313,7 +354,7 @@ class AdapterRegistry(Registry[Any]):
     @classmethod
     def from_entry_points(cls) -> AdapterRegistry:
         """Every adapter that installed packages declare in ``cosim.adapters`` (not imported)."""
-        return cls(_entry_points(ADAPTERS.entry_points))
+        return cls({**_entry_points(ADAPTERS.entry_points), **_given(ADAPTERS.entry_points)})
 
     def with_adapter(self, adapter: Any) -> AdapterRegistry:
         """A copy of this registry with ``adapter`` added under its own ``name``."""

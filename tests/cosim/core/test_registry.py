@@ -90,3 +90,32 @@ def test_the_installed_registry_lists_cosims_own_adapters_first_then_plugins_by_
     assert names[: len(ours)] == ours
     theirs = packages[len(ours) :]
     assert theirs == sorted(theirs)
+
+
+def test_an_entry_given_in_code_is_registered_while_inside_and_named_as_given():
+    from adapters.navigation.contract import CONTROLLERS
+    from cosim.core.plugins import plugin_of
+    from cosim.core.registry import registered
+
+    class Steady:
+        """Drives straight on."""
+
+        name = "steady"
+
+        def commands(self, inputs):
+            return inputs
+
+    with registered("cosim.controllers", "steady", Steady):
+        assert CONTROLLERS.installed().get("steady") is Steady
+        info = plugin_of(Steady)
+        assert info is not None and (info.package, info.name) == ("", "steady")
+    assert "steady" not in CONTROLLERS.installed()
+
+
+def test_an_entry_given_in_code_cannot_take_a_registered_name():
+    from cosim.core.errors import RegistryError
+    from cosim.core.registry import registered
+
+    with pytest.raises(RegistryError, match="'dwa' is registered in cosim.controllers already"):
+        with registered("cosim.controllers", "dwa", object()):
+            pass
