@@ -1,7 +1,7 @@
 """The ``cosim`` command line.
 
-Exit status: 0 done; 2 invalid input (one line on stderr naming the file, the key, the
-value and what was expected); 1 internal failure (a bug: the traceback is printed).
+Each command is a function of the parsed arguments returning the exit status;
+:mod:`cosim.cli.exits` says what each status means and prints the errors.
 """
 
 from __future__ import annotations
@@ -14,7 +14,14 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from cosim.cli.args import EXIT_INPUT, build_parser
+from cosim.cli.args import build_parser
+from cosim.cli.exits import (
+    EXIT_BUG,
+    EXIT_OK,
+    EXIT_RUNS_FAILED,
+    failed_runs_line,
+    say_error,
+)
 from cosim.cli.progress import ProgressLine
 from cosim.core.errors import ConfigError, CosimError
 from cosim.scenario import (
@@ -76,9 +83,6 @@ if TYPE_CHECKING:
     from cosim.recording.setup import RecordingSession
     from cosim.runner.result import RunResult
     from cosim.runner.stopping import RunStopped, StopRequest
-
-EXIT_OK = 0
-EXIT_BUG = 1
 
 
 def _load(args: argparse.Namespace) -> Scenario:
@@ -359,6 +363,9 @@ def _cmd_study(args: argparse.Namespace) -> int:
         f"results: {out}/results.parquet ({len(results)} runs, {failed} failed)"
         + (f", report: {out}/report.md" if (out / "report.md").exists() else "")
     )
+    if failed:
+        print(f"cosim: {failed_runs_line(results, out)}", file=sys.stderr)
+        return EXIT_RUNS_FAILED
     return EXIT_OK
 
 
@@ -460,8 +467,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return COMMANDS[args.command](args)
     except (CosimError, ConfigError) as error:
-        print(f"cosim: error: {error}", file=sys.stderr)
-        return EXIT_INPUT
+        return say_error(error)
     except KeyboardInterrupt:
         print("cosim: interrupted", file=sys.stderr)
         return 130

@@ -26,6 +26,10 @@ import simpy
 import simpy.rt
 from simpy.events import EventPriority
 
+HEARTBEAT_EVENTS = 256
+"""Events between two heartbeats (and looks at the wall clock for progress) of a run."""
+_HEARTBEAT_MASK = HEARTBEAT_EVENTS - 1
+
 
 class Stage(IntEnum):
     """Order of events that fall on the same nanosecond (lower runs first)."""
@@ -126,6 +130,7 @@ class Kernel:
         else:
             self.env = simpy.Environment(initial_time=0)
         self.events_processed = 0
+        """Events that completed in :meth:`run` (a failed or stopped run's included)."""
         self.speed = speed
         self.lateness: Lateness | None = Lateness() if realtime else None
         """Per-batch lateness of a real-time run (None when not real time)."""
@@ -215,6 +220,7 @@ class Kernel:
         *,
         progress: ProgressFn | None = None,
         progress_interval_s: float = 0.5,
+        heartbeat: Callable[[], None] | None = None,
     ) -> int:
         """Process every event due strictly before ``until_ns``; return how many ran.
 
@@ -225,6 +231,8 @@ class Kernel:
             until_ns: end of the run in ns.
             progress: called about every ``progress_interval_s`` of wall time.
             progress_interval_s: wall-clock seconds between progress calls.
+            heartbeat: called every :data:`HEARTBEAT_EVENTS` events (every event in real
+                time): the run is alive (a watchdog's beat).
         """
         env = self.env
         if isinstance(env, simpy.rt.RealtimeEnvironment):
@@ -232,22 +240,27 @@ class Kernel:
                 # the wall clock starts with the run, not when the kernel was built
                 env.sync()
                 self._wall_epoch_ns = time.time_ns() - round(self.now_ns / self.speed)
-            return self._run_realtime(env, until_ns, progress, progress_interval_s)
+            return self._run_realtime(env, until_ns, progress, progress_interval_s, heartbeat)
         step = env.step
         peek = env.peek
         processed = 0
         next_report = time.monotonic() + progress_interval_s
-        while peek() < until_ns:
-            step()
-            processed += 1
-            if progress is not None and processed & 0x3FF == 0:
-                wall = time.monotonic()
-                if wall >= next_report:
-                    progress(self.now_ns, processed)
-                    next_report = wall + progress_interval_s
+        checks = progress is not None or heartbeat is not None
+        try:
+            while peek() < until_ns:
+                step()
+                processed += 1
+                if checks and processed & _HEARTBEAT_MASK == 0:
+                    if heartbeat is not None:
+                        heartbeat()
+                    wall = time.monotonic()
+                    if progress is not None and wall >= next_report:
+                        progress(self.now_ns, processed)
+                        next_report = wall + progress_interval_s
+        finally:  # a failed event or a stop: the events that completed still count
+            self.events_processed += processed
         if until_ns > self.now_ns:
             env.run(until=until_ns)
-        self.events_processed += processed
         if progress is not None:
             progress(self.now_ns, processed)
         return processed
@@ -258,6 +271,7 @@ class Kernel:
         until_ns: int,
         progress: ProgressFn | None,
         progress_interval_s: float,
+        heartbeat: Callable[[], None] | None = None,
     ) -> int:
         """The run loop of a real-time kernel: paced, and lateness measured per batch."""
         assert self.lateness is not None
@@ -283,14 +297,16 @@ class Kernel:
                 step()
                 processed += 1
                 batch_events += 1
+                if heartbeat is not None:
+                    heartbeat()
                 if progress is not None and monotonic() >= next_report:
                     progress(self.now_ns, processed)
                     next_report = monotonic() + progress_interval_s
         finally:  # a stop (Ctrl-C, an error) may land anywhere: keep the columns aligned
             record.close_batch(batch_events)
+            self.events_processed += processed
         if until_ns > self.now_ns:
             env.run(until=until_ns)
-        self.events_processed += processed
         if progress is not None:
             progress(self.now_ns, processed)
         return processed

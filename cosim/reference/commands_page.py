@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from cosim.cli.args import build_parser
+from cosim.cli.exits import EXIT_STATUSES
 
 
 def _subparsers(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:
@@ -20,10 +21,14 @@ def commands_markdown() -> str:
     lines = [
         "# Command line",
         "",
-        "`cosim COMMAND ...`; every command answers `--help`. Exit status: 0 done; 2 "
-        "invalid input (one line on standard error naming the file, the key, the value and "
-        "what was expected, no traceback); 1 an internal failure (a bug). This page is "
-        "generated from the command line's own parser (`cosim/reference/commands_page.py`).",
+        "`cosim COMMAND ...`; every command answers `--help`. This page is generated from "
+        "the command line's own parser (`cosim/reference/commands_page.py`).",
+        "",
+        "## Exit status",
+        "",
+        "| status | meaning |",
+        "|---|---|",
+        *(f"| {status} | {meaning} |" for status, meaning in EXIT_STATUSES.items()),
         "",
         "```text",
         parser.format_help().rstrip(),

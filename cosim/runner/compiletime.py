@@ -73,6 +73,11 @@ class CompileClock:
             running = time.perf_counter() - self._since if self._depth > 0 else 0.0
             return self._total_s + running
 
+    @property
+    def compiling(self) -> bool:
+        """Whether numba is compiling a kernel now."""
+        return self._depth > 0
+
     def _started(self) -> None:
         with self._lock:
             if self._depth == 0:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import contextlib
 import platform
 import time
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from importlib.metadata import version
 from pathlib import Path
 from typing import Any
@@ -14,8 +14,9 @@ import numpy as np
 
 from adapters.unity.server import UnityOptions
 from cosim.core.adapter import AdapterType
-from cosim.core.errors import BridgeError, RegistryError
+from cosim.core.errors import BridgeError, CosimError, RegistryError
 from cosim.core.kernel import Lateness
+from cosim.core.plugins import PluginError, refuse
 from cosim.core.recorder import Recorder, merge_counts
 from cosim.core.registry import AdapterRegistry
 from cosim.core.table import TableSpec
@@ -25,9 +26,11 @@ from cosim.recording.foxglove import LiveOptions
 from cosim.recording.setup import RecordingPlan, RecordingSession
 from cosim.runner.assembly import Assembly, assemble
 from cosim.runner.compiletime import CompileClock
+from cosim.runner.faults import Hung, InternalError, fault_of, write_failure
 from cosim.runner.outfolder import prepare_out, write_run
 from cosim.runner.result import RunResult
 from cosim.runner.stopping import CHECK_EVERY_S, RunStopped, StopRequest, signal_name
+from cosim.runner.watchdog import Watchdog
 from cosim.scenario.model import Scenario
 
 ProgressFn = Callable[[float, float, float], None]
@@ -89,6 +92,11 @@ def execute(
         BridgeError: an external system failed while the kernel ran (a physical robot or a
             motion-capture server gone silent); the bag is finished and the error's
             ``kept`` holds the result of the simulated time reached.
+        PluginError: a plugin's code raised, hung past ``scenario.hang_timeout_s`` or
+            handed back a value cosim refuses; named, with its traceback (``details``) and,
+            once the run had started, ``kept`` as for a ``BridgeError``.
+        InternalError: cosim's own code failed once the run had started (a bug); ``kept``
+            and ``details`` likewise.
     """
     with CompileClock() as clock:  # numba's compile time, said apart from the speed
         with _immediate(stop):
@@ -96,15 +104,21 @@ def execute(
             registry, extra = with_adapters(
                 registry or AdapterRegistry.from_entry_points(), adapters
             )
-            assembly = assemble(
-                scenario,
-                names=names,
-                registry=registry,
-                extra=extra,
-                realtime=plan.realtime,
-                speed=live.rate if live is not None else 1.0,
-                recording=plan.active,
-            )
+            try:
+                assembly = assemble(
+                    scenario,
+                    names=names,
+                    registry=registry,
+                    extra=extra,
+                    realtime=plan.realtime,
+                    speed=live.rate if live is not None else 1.0,
+                    recording=plan.active,
+                )
+            except Exception as error:  # a plugin's constructor is named; a bug stays one
+                fault = fault_of(error, doing="building the run", t_ns=None)
+                if isinstance(fault, PluginError):
+                    raise fault from None
+                raise
             run = assembly.run
             topics = RecordingSession.topics_of(scenario, run.bus) if plan.active else {}
             session = RecordingSession(plan, topics, run.bus)
@@ -187,13 +201,14 @@ def _run_assembled(
     until_ns = s_to_ns(duration_s)
     wall_start = time.perf_counter()
     compiled_before_s = clock.seconds if clock is not None else 0.0
-    for _name, adapter in assembly.adapters:
-        adapter.start(run)
-    done = [0]  # events processed when the last check ran
+    watchdog = Watchdog(
+        scenario.scenario.hang_timeout_s,
+        busy=(lambda: clock.compiling) if clock is not None else None,
+    )
+    doing = "starting the run"
     next_progress = [0.0]
 
     def report(now_ns: int, events: int) -> None:
-        done[0] = events
         wall = time.perf_counter() - wall_start
         if progress is not None and (wall >= next_progress[0] or now_ns >= until_ns):
             progress(now_ns / NS_PER_S, duration_s, wall)
@@ -202,24 +217,42 @@ def _run_assembled(
             raise _HaltError
 
     halted = stop is not None and stop.requested
-    failure: BridgeError | None = None
+    failure: CosimError | None = None
+    events = 0
+    counted = run.kernel.events_processed
     try:
-        events = 0
-        if not halted:
-            events = run.kernel.run(
-                until_ns,
-                progress=report if progress is not None or stop is not None else None,
-                progress_interval_s=CHECK_EVERY_S if stop is not None else PROGRESS_EVERY_S,
-            )
+        with watchdog:
+            for name, adapter in assembly.adapters:
+                doing = f"starting adapter {name!r}"
+                watchdog.beat()
+                adapter.start(run)
+            doing = "running the simulation"
+            if not halted:
+                events = run.kernel.run(
+                    until_ns,
+                    progress=report if progress is not None or stop is not None else None,
+                    progress_interval_s=CHECK_EVERY_S if stop is not None else PROGRESS_EVERY_S,
+                    heartbeat=watchdog.beat if watchdog.active else None,
+                )
     except _HaltError:
-        halted, events = True, done[0]
+        halted, events = True, run.kernel.events_processed - counted
     except BridgeError as error:  # the real world failed (a silent robot, a mocap server)
-        halted, events, failure = True, done[0], error
+        halted, events, failure = True, run.kernel.events_processed - counted, error
+    except (Exception, Hung) as error:  # user code, or cosim's: named, and what ran kept
+        halted, events = True, run.kernel.events_processed - counted
+        failure = fault_of(error, doing=doing, t_ns=run.kernel.now_ns)
     finally:
-        for _name, adapter in assembly.adapters:
+        for name, adapter in assembly.adapters:
             close = getattr(adapter, "close", None)
-            if close is not None:
+            if close is None:
+                continue
+            try:
                 close()
+            except Exception as error:
+                if failure is None:
+                    failure = fault_of(error, doing=f"closing adapter {name!r}", t_ns=None)
+    if failure is not None:
+        halted = True
     # the run loop's own time: the first run on a machine compiles numba's kernels in it
     compiling_s = clock.seconds - compiled_before_s if clock is not None else 0.0
     wall_s = max(time.perf_counter() - wall_start - compiling_s, 0.0)
@@ -242,19 +275,34 @@ def _run_assembled(
         "network_messages": run.recorder.network_messages,
         "network_bytes": run.recorder.network_bytes,
     }
-    stopped = stop.signum if halted and stop is not None else None
+    now_ns = run.kernel.now_ns
+    stopped = stop.signum if halted and stop is not None and stop.signum is not None else None
     if stopped is not None:
         # a run that did not reach its duration says so before anything else
         summary = {"stopped": signal_name(stopped), "planned_duration_s": duration_s, **summary}
-    if failure is not None:
-        summary = {"failed": str(failure), "planned_duration_s": duration_s, **summary}
     if run.kernel.lateness is not None:
         summary.update(record_lateness(run.kernel.lateness, run.recorder))
+    unfinished = []
     for name, adapter in assembly.adapters:
         try:
-            merge_counts(summary, adapter.finish(run))
-        except ValueError as error:
-            raise RuntimeError(f"adapter {name!r}: {error}") from error
+            with Watchdog(scenario.scenario.hang_timeout_s):
+                metrics = adapter.finish(run)
+            if not isinstance(metrics, Mapping):
+                raise refuse(
+                    adapter,
+                    f"finish() returned {type(metrics).__name__}; expected a mapping of "
+                    "summary metrics (dict)",
+                )
+            merge_counts(summary, metrics)
+        except ValueError as error:  # a summary key given twice
+            failure = failure or refuse(adapter, f"finish(): {error}").at(run.kernel.now_ns)
+            unfinished.append(name)
+        except (Exception, Hung) as error:
+            unfinished.append(name)
+            if failure is None:  # once a run failed, adapters may fail to sum it up
+                failure = fault_of(error, doing=f"finishing adapter {name!r}", t_ns=now_ns)
+    if failure is not None:
+        summary = {**failure_summary(failure, duration_s, unfinished), **summary}
     return RunResult(
         scenario,
         summary,
@@ -265,6 +313,30 @@ def _run_assembled(
         stopped=stopped,
         failure=failure,
     )
+
+
+def failure_summary(failure: CosimError, planned_s: float, unfinished: list[str]) -> dict[str, Any]:
+    """The summary keys of a failed run, first: what failed, whose fault, what is missing.
+
+    ``failed`` is the one-line error; ``failure`` says whose fault it was (``plugin``,
+    ``cosim`` or ``external``/``input``), the plugin, and the adapters whose metrics are
+    missing because their ``finish`` failed after the fault.
+    """
+    if isinstance(failure, PluginError):
+        kind = "plugin"
+    elif isinstance(failure, InternalError):
+        kind = "cosim"
+    elif isinstance(failure, BridgeError):
+        kind = "external"
+    else:
+        kind = "input"
+    detail: dict[str, Any] = {"kind": kind}
+    plugin = getattr(failure, "plugin", None)
+    if plugin is not None:
+        detail["plugin"] = plugin.as_dict()
+    if unfinished:
+        detail["unfinished_adapters"] = unfinished
+    return {"failed": str(failure), "failure": detail, "planned_duration_s": planned_s}
 
 
 REALTIME = TableSpec(
@@ -357,6 +429,10 @@ def run(
         RunStopped: the run was asked to stop (``stop``).
         BridgeError: an external system failed mid-run; with ``out``, what ran is written
             there first and the message says where.
+        PluginError: a plugin's code failed (raised, hung, or handed back a value cosim
+            refuses); once the run had started, what ran is written to ``out`` as for a
+            ``BridgeError``, with the traceback in ``out/failure.txt``.
+        InternalError: cosim's own code failed mid-run (a bug); likewise.
     """
     if seed is not None:
         scenario = scenario.with_seed(seed)
@@ -377,11 +453,14 @@ def run(
                 figures=figures,
                 unity=unity,
             )
-        except BridgeError as error:
+        except CosimError as error:
             if error.kept is None or folder is None:
                 raise
             write_run(error.kept, folder, tables=scenario.record.tables)
             reached = error.kept.summary["sim_time_s"]
+            if getattr(error, "details", ""):
+                trace = write_failure(folder, error)
+                error.say_kept(f"the traceback is in {trace}")
             error.say_kept(
                 f"the results of the {reached:g} s simulated are in {folder}/ "
                 '(summary.json says "failed")'

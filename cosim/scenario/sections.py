@@ -42,6 +42,14 @@ class ScenarioSection:
         "extra adapters to start, by registered name (`cosim plugins`)",
         registry="cosim.adapters",
     )
+    hang_timeout_s: float = param(
+        60.0,
+        "wall-clock time one step of the run (an event, an adapter's start or finish) may "
+        "take before the code running is stopped as hung, named, and the results so far "
+        "kept (s; 0: never)",
+        ge=0,
+        le=86400,
+    )
 
     def problems(self) -> Iterator[Problem]:
         """The name is one folder name: runs are written to ``runs/NAME-seedN``."""

@@ -303,6 +303,15 @@ def standard_figures(
     ]
 
 
+FAULT_WORDS = {
+    "plugin": "a plugin's fault",
+    "cosim": "cosim's own bug",
+    "external": "an external system",
+    "input": "bad input",
+}
+"""How report.md says whose fault a failed run was (``failure_kind``)."""
+
+
 def write_report(
     study_dir: Path,
     *,
@@ -337,7 +346,15 @@ def write_report(
         lines += ["### Failed runs", ""]
         for run in failed.head(ERRORS_LISTED).itertuples(index=False):
             message = (str(getattr(run, "error", "")).strip() or "no message").splitlines()[0]
-            lines.append(f"- `{run.run_id}` (seed {run.seed}): {message[:300]}")
+            kind = getattr(run, "failure_kind", "")
+            whose = f", {FAULT_WORDS.get(kind, kind)}" if isinstance(kind, str) and kind else ""
+            failure_path = Path("runs") / str(run.run_id) / "failure.txt"
+            trace = (
+                f" ([traceback]({failure_path.as_posix()}))"
+                if (study_dir / failure_path).is_file()
+                else ""
+            )
+            lines.append(f"- `{run.run_id}` (seed {run.seed}{whose}): {message[:300]}{trace}")
         lines += [f"- … and {len(failed) - ERRORS_LISTED} more"] * (len(failed) > ERRORS_LISTED)
         lines.append("")
     lines += ["## Results", ""]

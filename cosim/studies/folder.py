@@ -29,6 +29,7 @@ from typing import Any
 import pandas as pd
 
 from cosim.core.errors import ConfigError, ExportError
+from cosim.runner.faults import FAILURE_FILE
 from cosim.scenario import Scenario, load_scenario
 from cosim.scenario.loader import dump_scenario
 from cosim.studies.spec import RunSpec, StudySpec
@@ -442,6 +443,8 @@ def _write_run_files(partial: Path, outcome: Outcome) -> None:
         (partial / "tables").mkdir()
         for name, data in outcome.tables.items():
             (partial / "tables" / f"{name}.parquet").write_bytes(data)
+    if outcome.failure:
+        (partial / FAILURE_FILE).write_text(outcome.failure)
     (partial / ROW_FILE).write_text(json.dumps(outcome.row, indent=1, default=str) + "\n")
 
 

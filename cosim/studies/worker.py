@@ -16,6 +16,7 @@ from typing import Any
 
 from cosim.core.errors import CosimError
 from cosim.runner.execute import execute
+from cosim.runner.result import RunResult
 from cosim.scenario import Scenario, load_scenario
 from cosim.scenario.loader import dump_scenario
 
@@ -60,12 +61,15 @@ class Outcome:
         scenario_toml: the resolved scenario (empty if it failed to load).
         summary: the run's summary.
         tables: Parquet bytes by table name (only those asked for).
+        failure: a failed run's one-line error and traceback (its folder's
+            ``failure.txt``), or ``""``.
     """
 
     row: dict[str, Any]
     scenario_toml: str
     summary: dict[str, Any]
     tables: dict[str, bytes]
+    failure: str = ""
 
 
 def _cell(value: Any) -> Any:
@@ -108,30 +112,75 @@ def row_cells(job: Job) -> dict[str, Any]:
     return row
 
 
-def failed(job: Job, error: str, wall_time_s: float) -> Outcome:
-    """The outcome of a run that did not finish: its row says why."""
+def failed(
+    job: Job, error: str, wall_time_s: float, *, kind: str = "input", failure: str = ""
+) -> Outcome:
+    """The outcome of a run that did not start: its row says why."""
     row = row_cells(job)
-    row.update(status="error", error=error, wall_time_s=round(wall_time_s, 4))
-    return Outcome(row, "", {}, {})
+    row.update(status="error", error=error, failure_kind=kind, wall_time_s=round(wall_time_s, 4))
+    return Outcome(row, "", {}, {}, failure)
 
 
 def run_one(job: Job) -> Outcome:
-    """Run one study run; failures come back as a row with status ``error``, never raise."""
+    """Run one study run; failures come back as a row with status ``error``, never raise.
+
+    A run that failed once it had started (a plugin's fault, cosim's own, an external
+    system's) keeps what ran: its summary of the simulated time reached, its tables and
+    its traceback (``failure``), as ``cosim run`` keeps them in a run folder.
+    """
     start = time.perf_counter()
+    scenario = None
     try:
         scenario = job_scenario(job)
         result = execute(scenario)
     except CosimError as error:
-        return failed(job, str(error), time.perf_counter() - start)
+        kept = error.kept
+        kind = _kind(error)
+        trace = f"{error}\n\n{getattr(error, 'details', '')}" if kind != "input" else ""
+        if kept is None or scenario is None:
+            return failed(job, str(error), time.perf_counter() - start, kind=kind, failure=trace)
+        return _outcome(job, kept, dump_scenario(scenario), str(error), kind, trace)
     except Exception as error:  # a bug in a run must not stop the study
         detail = "".join(traceback.format_exception_only(type(error), error)).strip()
-        return failed(job, f"internal error: {detail}", time.perf_counter() - start)
+        trace = "".join(traceback.format_exception(error))
+        return failed(
+            job,
+            f"internal error: {detail}",
+            time.perf_counter() - start,
+            kind="cosim",
+            failure=f"internal error: {detail}\n\n{trace}",
+        )
+    return _outcome(job, result, dump_scenario(scenario), "", "", "")
+
+
+def _kind(error: CosimError) -> str:
+    """Whose fault a run's error was: ``plugin``, ``cosim``, ``external`` or ``input``."""
+    kept = error.kept
+    failure = kept.summary.get("failure") if kept is not None else None
+    if isinstance(failure, dict) and isinstance(failure.get("kind"), str):
+        return str(failure["kind"])
+    from cosim.core.plugins import PluginError
+    from cosim.runner.faults import InternalError
+
+    if isinstance(error, PluginError):
+        return "plugin"
+    return "cosim" if isinstance(error, InternalError) else "input"
+
+
+def _outcome(
+    job: Job, result: RunResult, scenario_toml: str, error: str, kind: str, failure: str
+) -> Outcome:
     row = row_cells(job)
     summary = result.summary
     for key, value in summary.items():
-        if key not in ("scenario", "source", "seed"):
+        if key not in ("scenario", "source", "seed", "failed", "failure"):
             row[key] = value
-    row.update(status="ok", error="", wall_time_s=summary["wall_time_s"])
+    row.update(
+        status="error" if error else "ok",
+        error=error,
+        failure_kind=kind,
+        wall_time_s=summary["wall_time_s"],
+    )
     wanted = (
         result.tables
         if "*" in job.tables
@@ -142,4 +191,4 @@ def run_one(job: Job) -> Outcome:
         buffer = io.BytesIO()
         frame.to_parquet(buffer, index=False)
         tables[name] = buffer.getvalue()
-    return Outcome(row, dump_scenario(scenario), summary, tables)
+    return Outcome(row, scenario_toml, summary, tables, failure)

@@ -318,3 +318,49 @@ def test_every_shipped_study_file_loads_with_a_report_and_distinct_run_ids(path)
     runs = spec.runs()
     assert runs and len({r.run_id for r in runs}) == len(runs)
     assert spec.report, f"{path.name} has no [report]"
+
+
+class Flaky:
+    """An adapter that fails in the runs with 50 ms of latency, after 2 simulated seconds."""
+
+    name = "flaky"
+    requires = ()
+
+    def __init__(self, run):
+        from adapters.network.settings import NetworkConfig
+
+        self.fails = run.settings(NetworkConfig).latency_ms == 50
+
+    def start(self, run):
+        from cosim.core.kernel import Stage
+
+        run.kernel.every(1_000_000_000, self.tick, stage=Stage.CONTROL)
+
+    def tick(self, now_ns):
+        if self.fails and now_ns >= 2_000_000_000:
+            raise RuntimeError("flaky sensor")
+
+    def finish(self, run):
+        return {}
+
+
+def test_runs_failing_in_a_plugin_keep_their_traceback_and_the_study_exits_4(tmp_path):
+    from cosim.core.registry import registered
+
+    text = TINY.format(duration=4.0) + '"scenario.adapters" = ["flaky"]\n'
+    with registered("cosim.adapters", "flaky", Flaky):
+        done = cli("study", str(_study(tmp_path, text)), "--out", "out", "--workers", "1",
+                   cwd=tmp_path)  # fmt: skip
+    assert done.returncode == 4, done.stderr
+    assert "cosim: 4 of 8 runs failed (4 in a plugin):" in done.stderr
+    out = tmp_path / "out"
+    results = pd.read_parquet(out / "results.parquet")
+    failed = results[results["status"] == "error"]
+    assert set(failed["network.latency_ms"]) == {50} and len(failed) == 4
+    assert set(failed["failure_kind"]) == {"plugin"}
+    assert failed["error"].str.contains("adapter 'flaky'").all()
+    assert (failed["sim_time_s"] == 2.0).all()  # what ran is in the row
+    for run_id in failed["run_id"]:
+        trace = (out / "runs" / run_id / "failure.txt").read_text()
+        assert "RuntimeError: flaky sensor" in trace
+        assert (out / "runs" / run_id / "summary.json").is_file()
