@@ -288,13 +288,15 @@ def _print_run(result: RunResult, out: Path, figures: list[Path]) -> None:
 def _cmd_check(args: argparse.Namespace) -> int:
     from cosim.recording.setup import RecordingSession
     from cosim.runner.assembly import assemble
+    from cosim.runner.faults import plugin_faults_named
     from cosim.scenario import dump_scenario
 
     scenario = _load(args)
     # builds the world and every adapter: impossible requests fail here, as do topic
     # patterns that match nothing the run would record
     recording = scenario.record.bag != "none"
-    assembly = assemble(scenario, recording=recording)
+    with plugin_faults_named("building the run"):
+        assembly = assemble(scenario, recording=recording)
     if recording:
         RecordingSession.topics_of(scenario, assembly.run.bus)
     print(f"ok: {_describe(scenario)}")

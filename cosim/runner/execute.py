@@ -26,7 +26,13 @@ from cosim.recording.foxglove import LiveOptions
 from cosim.recording.setup import RecordingPlan, RecordingSession
 from cosim.runner.assembly import Assembly, assemble
 from cosim.runner.compiletime import CompileClock
-from cosim.runner.faults import Hung, InternalError, fault_of, write_failure
+from cosim.runner.faults import (
+    Hung,
+    InternalError,
+    fault_of,
+    plugin_faults_named,
+    write_failure,
+)
 from cosim.runner.outfolder import prepare_out, write_run
 from cosim.runner.result import RunResult
 from cosim.runner.stopping import CHECK_EVERY_S, RunStopped, StopRequest, signal_name
@@ -104,7 +110,7 @@ def execute(
             registry, extra = with_adapters(
                 registry or AdapterRegistry.from_entry_points(), adapters
             )
-            try:
+            with plugin_faults_named("building the run"):
                 assembly = assemble(
                     scenario,
                     names=names,
@@ -114,11 +120,6 @@ def execute(
                     speed=live.rate if live is not None else 1.0,
                     recording=plan.active,
                 )
-            except Exception as error:  # a plugin's constructor is named; a bug stays one
-                fault = fault_of(error, doing="building the run", t_ns=None)
-                if isinstance(fault, PluginError):
-                    raise fault from None
-                raise
             run = assembly.run
             topics = RecordingSession.topics_of(scenario, run.bus) if plan.active else {}
             session = RecordingSession(plan, topics, run.bus)

@@ -11,7 +11,9 @@ runner keeps what ran and writes the traceback into the run folder (:data:`FAILU
 
 from __future__ import annotations
 
+import contextlib
 import traceback
+from collections.abc import Iterator
 from pathlib import Path
 from types import FrameType, TracebackType
 
@@ -111,6 +113,24 @@ def fault_of(
     if plugin is None:
         return InternalError(problem, doing=doing, t_ns=t_ns, details=details)
     return PluginError(plugin, problem, doing=doing, t_ns=t_ns, details=details)
+
+
+@contextlib.contextmanager
+def plugin_faults_named(doing: str) -> Iterator[None]:
+    """While inside, an exception from a plugin's code becomes its :class:`PluginError`.
+
+    Before a run starts (building it, checking a scenario) nothing is kept: an exception
+    whose traceback holds no plugin's frame (cosim's own bug, bad input) goes on as it is.
+    """
+    try:
+        yield
+    except Exception as error:
+        if isinstance(error, CosimError) and not isinstance(error, PluginError):
+            raise
+        fault = fault_of(error, doing=doing, t_ns=None)
+        if isinstance(fault, PluginError):
+            raise fault from None
+        raise
 
 
 def blame(trace: TracebackType | None) -> tuple[PluginInfo | None, str]:

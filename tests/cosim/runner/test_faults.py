@@ -200,3 +200,16 @@ def test_errors_of_faults_cross_processes_whole():
     assert str(pickle.loads(pickle.dumps(internal))) == str(internal)
     assert isinstance(Hung(2.0), BaseException) and not isinstance(Hung(2.0), Exception)
     assert issubclass(BridgeError, Exception)
+
+
+def test_cosim_check_names_a_plugin_that_cannot_be_built(faulty, tmp_path):
+    from tests.conftest import cosim_main
+
+    faulty("init")
+    done = cosim_main(
+        "check", "warehouse-random", "--set", 'scenario.adapters=["faulty"]', cwd=tmp_path
+    )
+    assert done.returncode == 3
+    assert done.stderr.startswith("cosim: plugin error: adapter 'faulty'")
+    assert "raised RuntimeError: cannot build in Faulty.__init__" in done.stderr
+    assert "Traceback (most recent call last)" in done.stderr  # no run folder to hold it
