@@ -66,7 +66,7 @@ def resolve(
             value that is not a string, a preset or file that does not exist, a folder,
             or a chain that comes back to a file it passed.
     """
-    source = _source(origin)
+    source = _source(origin, presets)
     layers: list[tuple[str, dict[str, Any]]] = []
     seen = [source]
     while True:
@@ -87,8 +87,9 @@ def resolve(
     return _merge(layers)
 
 
-def _source(origin: str) -> _Source:
-    if origin.startswith("preset "):
+def _source(origin: str, presets: Callable[[], list[str]]) -> _Source:
+    """The scenario ``origin`` names: a preset (``"preset NAME"``) or a file."""
+    if origin.startswith("preset ") and origin.removeprefix("preset ") in presets():
         return _Source(origin, None, origin)
     path = Path(origin)
     return _Source(origin, path.parent, str(path.resolve()))

@@ -1,4 +1,8 @@
-"""Loading scenarios: TOML files or presets, ``--set`` overrides, and the resolved dump."""
+"""Loading scenarios: TOML files or presets, ``--set`` overrides, and the resolved dump.
+
+A file may extend a preset or another file (``extends = ...``): the chain is resolved by
+:mod:`cosim.scenario.extends` before the sections are validated.
+"""
 
 from __future__ import annotations
 
@@ -107,7 +111,8 @@ def load_scenario(
     """Load and validate a scenario from a TOML file or a preset name.
 
     Args:
-        spec: a path to a TOML file, or the name of a preset (``cosim scenarios``).
+        spec: a path to a TOML file (which may extend a preset or another file), or the
+            name of a preset (``cosim scenarios``).
         overrides: ``{"section.key": value}`` applied on top of the file.
         override_origin: how messages name the origin of overrides.
         override_origins: how messages name the origin of some overrides, by key (a

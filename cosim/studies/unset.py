@@ -36,7 +36,7 @@ def fill_unset(study_dir: Path, keys: Sequence[str | None]) -> list[str]:
 
     Returns:
         One note per key some ok runs still have no value of (they are left out of the
-        figures and tables grouped by it), naming them.
+        figures grouped by it), naming them.
 
     Raises:
         ExportError: the results cannot be read or written.

@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from cosim.core.errors import ConfigError
 from cosim.scenario import dump_scenario, load_scenario, preset_names
-from cosim.scenario.extends import merged
+from cosim.scenario.extends import merged, resolve
 from tests.conftest import cosim_main
 
 SMALL = """\
@@ -210,6 +210,32 @@ def test_tables_merge_key_by_key_at_any_depth_and_other_values_replace():
         "g": {"x": 1},
     }
     assert below == {"a": {"b": 1, "c": {"d": 2, "e": [1, 2]}}, "f": [1], "g": 3}
+
+
+def _presets(texts):
+    """A reader of the presets ``texts`` (name -> raw TOML), as the loader reads presets."""
+
+    def read(name):
+        return f"preset {name}", texts[name]
+
+    return read
+
+
+def test_a_preset_may_extend_a_preset_and_each_key_names_the_preset_that_set_it():
+    read = _presets({"base": {"robots": {"count": 2, "driver": "wander"}}})
+    top = {"extends": "base", "robots": {"count": 5}}
+    layers = resolve("preset top", top, read=read, presets=lambda: ["base", "top"])
+    assert layers.raw == {"robots": {"count": 5, "driver": "wander"}}
+    assert layers.keys == {("robots", "count"): "preset top", ("robots", "driver"): "preset base"}
+    assert layers.sections == {"robots": "preset top"}
+
+
+def test_a_preset_cannot_extend_a_file():
+    with pytest.raises(ConfigError) as error:
+        resolve("preset top", {"extends": "a.toml"}, read=_presets({}), presets=lambda: ["top"])
+    assert str(error.value) == (
+        "preset top: extends = 'a.toml': a preset extends only presets; expected a preset name"
+    )
 
 
 # --- fuzzing: whatever extends holds, one line naming the file and the value -----------------
