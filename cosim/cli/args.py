@@ -318,6 +318,15 @@ def build_parser() -> argparse.ArgumentParser:
         ),
     )
     study.add_argument("study", metavar="STUDY.toml", type=Path, help="the study file")
+    study.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="SECTION.KEY=VALUE",
+        help="set one scenario key in every run, over [overrides], e.g. --set robots.count=8 "
+        "(repeatable; values are TOML; not a key the study varies)",
+    )
     study.add_argument("--out", type=Path, help="study folder (default: runs/studies/NAME)")
     study.add_argument("--workers", type=_positive_int, help="local processes (default: cores)")
     study.add_argument(

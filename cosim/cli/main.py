@@ -335,7 +335,7 @@ def _cmd_study(args: argparse.Namespace) -> int:
     # SIGTERM stops a study as Ctrl-C does: finished runs kept, one line, 128 + the signal
     try:
         with stop_on_signals():
-            spec = load_study(args.study)
+            spec = load_study(args.study, dict(map(parse_override, args.overrides)))
             out = args.out or Path("runs") / "studies" / spec.name
             total = len(spec.runs())
             where = (

@@ -1,4 +1,8 @@
-"""Loading scenarios: TOML files or presets, ``--set`` overrides, and the resolved dump."""
+"""Loading scenarios: TOML files or presets, ``--set`` overrides, and the resolved dump.
+
+A file may extend a preset or another file (``extends = ...``): the chain is resolved by
+:mod:`cosim.scenario.extends` before the sections are validated.
+"""
 
 from __future__ import annotations
 
@@ -12,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from cosim.core.errors import ConfigError, RegistryError
+from cosim.scenario.extends import resolve as resolve_extends
 from cosim.scenario.fields import build, show_name, show_value, suggest
 from cosim.scenario.model import Scenario, section_classes, section_registry
 from cosim.scenario.tomlfile import (
@@ -101,31 +106,37 @@ def load_scenario(
     overrides: Mapping[str, Any] | None = None,
     *,
     override_origin: str = "--set",
+    override_origins: Mapping[str, str] | None = None,
 ) -> Scenario:
     """Load and validate a scenario from a TOML file or a preset name.
 
     Args:
-        spec: a path to a TOML file, or the name of a preset (``cosim scenarios``).
+        spec: a path to a TOML file (which may extend a preset or another file), or the
+            name of a preset (``cosim scenarios``).
         overrides: ``{"section.key": value}`` applied on top of the file.
         override_origin: how messages name the origin of overrides.
+        override_origins: how messages name the origin of some overrides, by key (a
+            study's ``--set`` among its grid's keys); the others: ``override_origin``.
 
     Raises:
         ConfigError: for a missing file, malformed TOML, an unknown section or key, or a
             value of the wrong type or out of bounds; the message names all of them.
     """
     origin, raw = _read_source(spec)
-    raw = copy.deepcopy(raw)
-    origins: dict[tuple[str, str], str] = {}
+    layers = resolve_extends(origin, copy.deepcopy(raw), read=_read_source, presets=preset_names)
+    raw, origins = layers.raw, dict(layers.keys)
     for dotted, value in (overrides or {}).items():
         section, _, key = dotted.partition(".")
         if not key or "." in key:
             raise ConfigError(f"{override_origin} {dotted}: expected section.key")
         table = raw.setdefault(section, {})
         if not isinstance(table, dict):
-            raise ConfigError(f"{origin}: {section} must be a [section] table")
+            where = layers.sections.get(section, origin)
+            raise ConfigError(f"{where}: {section} must be a [section] table")
         table[key] = value
-        origins[(section, key)] = f"{override_origin} {dotted}"
-    return _build(raw, origin, origins)
+        named = (override_origins or {}).get(dotted, override_origin)
+        origins[(section, key)] = f"{named} {dotted}"
+    return _build(raw, origin, origins, layers.sections)
 
 
 def section_types() -> dict[str, type[Any]]:
@@ -133,11 +144,24 @@ def section_types() -> dict[str, type[Any]]:
     return section_classes()
 
 
-def _build(raw: dict[str, Any], origin: str, origins: dict[tuple[str, str], str]) -> Scenario:
+def _build(
+    raw: dict[str, Any],
+    origin: str,
+    origins: dict[tuple[str, str], str],
+    sections: Mapping[str, str] | None = None,
+) -> Scenario:
+    """Validate raw sections into a scenario.
+
+    ``origins`` names where each (section, key) came from and ``sections`` where each
+    section did (a file of an ``extends`` chain, ``--set``); ``origin`` where neither says.
+    """
     registry = section_registry()
+    sections = sections or {}
     for section in raw:
         if section not in registry:
-            where = next((o for (s, _), o in origins.items() if s == section), origin)
+            where = sections.get(section) or next(
+                (o for (s, _), o in origins.items() if s == section), origin
+            )
             raise ConfigError(
                 f"{where}: unknown section [{show_name(section)}]"
                 + suggest(section, registry.names())
@@ -150,14 +174,15 @@ def _build(raw: dict[str, Any], origin: str, origins: dict[tuple[str, str], str]
     built: dict[str, Any] = {}
     for section, cls in classes.items():
         table = raw.get(section, {})
+        where = sections.get(section, origin)
         if not isinstance(table, dict):
             raise ConfigError(
-                f"{origin}: {section} = {show_value(table)}: expected a [{section}] table of keys"
+                f"{where}: {section} = {show_value(table)}: expected a [{section}] table of keys"
             )
-        key_origins = {key: origins.get((section, key), origin) for key in table}
-        table, key_origins = _apply_profile(cls, table, key_origins, section, origin)
+        key_origins = {key: origins.get((section, key), where) for key in table}
+        table, key_origins = _apply_profile(cls, table, key_origins, section, where)
         built[section] = _resolve_paths(
-            build(cls, table, section=section, origins=key_origins, default_origin=origin),
+            build(cls, table, section=section, origins=key_origins, default_origin=where),
             key_origins,
         )
     return Scenario(built, source=origin)

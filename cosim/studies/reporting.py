@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import sys
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -26,6 +27,7 @@ from cosim.studies.folder import write_results
 from cosim.studies.labels import axis_label, short_label
 from cosim.studies.spec import StudySpec
 from cosim.studies.timeseries import timeseries_figures
+from cosim.studies.unset import fill_unset
 
 DEFAULT_METRICS = (
     "tasks_per_min",
@@ -39,8 +41,14 @@ MAX_X_TICKS = 12
 """Log-log figures label up to this many x values themselves, beyond it powers of ten."""
 
 
-def report_study(spec: StudySpec, out: Path) -> Path:
+def report_study(
+    spec: StudySpec, out: Path, *, notify: Callable[[str], None] | None = None
+) -> Path:
     """Write ``figures/*.png`` and ``report.md`` for a finished (or partial) study.
+
+    Runs that do not set a key the report groups by (x, hue, facet) are grouped under the
+    value their scenario used (:func:`~cosim.studies.unset.fill_unset`); runs still left
+    out are named in ``report.md`` and told to ``notify`` (default: stderr), a line each.
 
     Derived metrics the report names (:data:`~cosim.studies.derived.DERIVED_METRICS`) are added to
     ``results.parquet`` as columns first, so the tables, the figures and later analysis of
@@ -59,6 +67,9 @@ def report_study(spec: StudySpec, out: Path) -> Path:
     metrics = list(report.get("metrics", DEFAULT_METRICS))
     loglog = list(report.get("loglog", []))
     heatmaps = list(report.get("heatmaps", []))
+    left_out = fill_unset(out, [x, hue, facet])
+    for line in left_out:
+        (notify or _warn)(line)
     derived = add_derived_metrics(out, [*metrics, *loglog, *heatmaps])
     figures = standard_figures(out, x=x, hue=hue, metrics=metrics, facet=facet)
     if heatmaps and x is not None and facet is not None:
@@ -68,7 +79,7 @@ def report_study(spec: StudySpec, out: Path) -> Path:
             if metric in ok.columns and ok[metric].notna().any():
                 target = out / FIGURES_DIR / f"{metric}_over_{x}_and_{facet}.png"
                 figures.append(heatmap(ok, x=x, y=facet, metric=metric, facet=hue, out=target))
-    notes = [f"`{name}`: {DERIVED_METRICS[name].formula}." for name in derived]
+    notes = [*left_out, *(f"`{name}`: {DERIVED_METRICS[name].formula}." for name in derived)]
     if loglog and x is not None:
         drawn, left_out = loglog_figures(out, x=x, metrics=loglog, hue=hue, facet=facet)
         figures += drawn
@@ -86,6 +97,11 @@ def report_study(spec: StudySpec, out: Path) -> Path:
         figures=figures,
         facet=facet,
     )
+
+
+def _warn(line: str) -> None:
+    sys.stderr.write(f"study: {line}\n")
+    sys.stderr.flush()
 
 
 def add_derived_metrics(study_dir: Path, names: Sequence[str]) -> list[str]:

@@ -118,7 +118,8 @@ def run_study(
         resume: continue a study in ``out``: skip finished runs, retry failed ones.
         progress: told the run count, then called after every finished run.
         report: write figures and report.md when the study has a ``[report]`` section.
-        notify: told, a line each, what resuming found (a plan rebuilt, runs run again).
+        notify: told, a line each, what resuming found (a plan rebuilt, runs run again)
+            and the runs the report leaves out of a figure.
 
     Raises:
         ExportError: for a non-empty ``out`` without ``resume``, or a folder that cannot
@@ -157,7 +158,7 @@ def run_study(
     if report and spec.report and len(results):
         from cosim.studies.reporting import report_study
 
-        report_study(spec, out)
+        report_study(spec, out, notify=notify)
     return results
 
 

@@ -33,6 +33,9 @@ its ``scenario.duration_s``: a grid, case or override of those keys would be rec
 results without being run, so it is refused. So are grids and cases over ``record`` keys
 that study runs ignore (they write no bag; ``tables`` decides the tables kept).
 
+``cosim study --set KEY=VALUE`` sets a key in every run, over ``[overrides]``
+(:func:`with_sets`); a key the study varies or sets itself is refused, naming both.
+
 Every combination is loaded as a scenario before the study starts, and its adapters check
 the sections they need together (:func:`cosim.studies.validate.load_study` reads the file
 with :func:`read_study`, then validates it), so a bad key or value, a combination that
@@ -45,7 +48,8 @@ from __future__ import annotations
 import itertools
 import math
 import re
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -99,6 +103,8 @@ class StudySpec:
         report: the ``[report]`` section (x, hue, facet, metrics, heatmaps, loglog,
             timeseries).
         description: free text for the report.
+        sets: ``cosim study --set`` overrides: set in every run, over ``overrides``
+            (:func:`with_sets`).
     """
 
     path: Path
@@ -112,6 +118,7 @@ class StudySpec:
     cases: tuple[dict[str, Any], ...]
     report: dict[str, Any]
     description: str
+    sets: dict[str, Any] = field(default_factory=dict)
 
     def combinations(self) -> list[dict[str, Any]]:
         """Every override combination, in a fixed order: cases outer, grid inner."""
@@ -121,7 +128,8 @@ class StudySpec:
             for values in itertools.product(*(self.grid[k] for k in keys))
         ]
         cases = list(self.cases) or [{}]
-        return [{**self.overrides, **case, **point} for case in cases for point in points]
+        every = {**self.overrides, **self.sets}
+        return [{**every, **case, **point} for case in cases for point in points]
 
     def runs(self) -> list[RunSpec]:
         """Every run: each combination for each seed."""
@@ -220,6 +228,33 @@ def read_study(path: str | Path) -> StudySpec:
         report=report,
         description=description,
     )
+
+
+def with_sets(spec: StudySpec, sets: Mapping[str, Any]) -> StudySpec:
+    """The study with ``cosim study --set`` overrides set in every run (over ``[overrides]``).
+
+    Args:
+        spec: the study as read (:func:`read_study`).
+        sets: ``section.key`` -> value, as :func:`~cosim.scenario.loader.parse_override`
+            reads them.
+
+    Raises:
+        ConfigError: naming the study file and the ``--set``, for a key the study varies
+            (``[grid]``, ``[[cases]]``) or sets itself (``scenario.seed``; with ``[study]
+            duration_s``, ``scenario.duration_s``).
+    """
+    for key, value in sets.items():
+        where = f"{spec.path}: --set {key} = {show_value(value)}"
+        varied_in = ["grid"] if key in spec.grid else []
+        varied_in += [f"cases[{i}]" for i, case in enumerate(spec.cases) if key in case]
+        if varied_in:
+            raise ConfigError(
+                f"{where}: the study varies {key!r} in [{varied_in[0]}]; expected a key it "
+                f"does not vary (drop it from --set, or from [{varied_in[0]}])"
+            )
+        if problem := _study_set_problem(key, spec.duration_s, varied=False):
+            raise ConfigError(f"{where}: {problem}")
+    return replace(spec, sets={**spec.sets, **sets})
 
 
 def _name(path: Path, name: str) -> str:

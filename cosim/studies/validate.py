@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 from cosim.core.errors import ConfigError
 from cosim.core.registry import AdapterRegistry
@@ -22,7 +23,7 @@ from cosim.scenario import Scenario, load_scenario
 from cosim.scenario.fields import show_value
 from cosim.studies.derived import DERIVED_METRICS
 from cosim.studies.reportspec import RunColumns, check_report_names, names_to_check, study_keys
-from cosim.studies.spec import StudySpec, read_study
+from cosim.studies.spec import StudySpec, read_study, with_sets
 from cosim.studies.worker import run_overrides
 
 PROBE_S = 0.001
@@ -36,12 +37,15 @@ def combination_scenarios(spec: StudySpec) -> list[Scenario]:
         ConfigError: naming the study file, the combination, the key and the value.
     """
     origin = f"{spec.path} [grid/overrides/cases]"
+    named = dict.fromkeys(spec.sets, "--set")
     registry = AdapterRegistry.from_entry_points()
     scenarios = []
     for combination in spec.combinations():
         overrides = run_overrides(combination, seed=None, duration_s=spec.duration_s)
         try:
-            scenario = load_scenario(spec.scenario, overrides, override_origin=origin)
+            scenario = load_scenario(
+                spec.scenario, overrides, override_origin=origin, override_origins=named
+            )
         except ConfigError as error:
             raise _in_study(spec, error) from None
         try:
@@ -56,18 +60,26 @@ def combination_scenarios(spec: StudySpec) -> list[Scenario]:
 def _in_study(spec: StudySpec, error: ConfigError) -> ConfigError:
     """An error of the study's scenario, prefixed by the study file when it does not name it."""
     text = str(error)
-    if str(spec.path) in text:
+    if str(spec.path) in text or text.startswith("--set "):  # a --set names itself, as in run
         return error
     return ConfigError(f"{spec.path}: [study] scenario = {spec.scenario!r}: {text}")
 
 
-def load_study(path: str | Path) -> StudySpec:
+def load_study(path: str | Path, sets: Mapping[str, Any] | None = None) -> StudySpec:
     """Read and validate a study file (every combination is checked as a scenario).
 
+    Args:
+        path: the study file.
+        sets: ``section.key`` -> value set in every run (``cosim study --set``,
+            :func:`~cosim.studies.spec.with_sets`).
+
     Raises:
-        ConfigError: naming the file, the section, the key, the value and what was expected.
+        ConfigError: naming the file, the section, the key, the value and what was expected
+            (or the ``--set``).
     """
     spec = read_study(path)
+    if sets:
+        spec = with_sets(spec, sets)
     validate_study(spec)
     return spec
 
@@ -93,7 +105,7 @@ def validate_study(spec: StudySpec) -> None:
             f"{', '.join(sorted(columns.tables))})"
         )
     if check_names:
-        keys = study_keys(spec.grid, spec.overrides, spec.cases)
+        keys = study_keys(spec.grid, {**spec.overrides, **spec.sets}, spec.cases)
         kept = columns.tables if "*" in spec.tables else _only(columns.tables, named)
         check_report_names(spec.path, spec.report, keys, _with_tables(columns, kept))
 
