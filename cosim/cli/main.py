@@ -24,6 +24,7 @@ from cosim.scenario import (
     preset_names,
     preset_summary,
 )
+from cosim.scenario.provenance import provenance_note
 
 
 def _count(value: Any) -> str:
@@ -82,11 +83,16 @@ EXIT_BUG = 1
 
 
 def _load(args: argparse.Namespace) -> Scenario:
+    """The scenario of ``args``; a note on stderr when its ``[provenance]`` is not installed."""
     overrides: dict[str, Any] = {}
     for text in args.overrides:
         key, value = parse_override(text)
         overrides[key] = value
-    return load_scenario(args.scenario, overrides)
+    scenario = load_scenario(args.scenario, overrides)
+    note = provenance_note(scenario.source, scenario.resolved_with)
+    if note is not None:
+        print(note, file=sys.stderr)
+    return scenario
 
 
 def _describe(scenario: Scenario) -> str:

@@ -14,6 +14,7 @@ from typing import Any
 from cosim.core.errors import ConfigError, RegistryError
 from cosim.scenario.fields import build, show_name, show_value, suggest
 from cosim.scenario.model import Scenario, section_classes, section_registry
+from cosim.scenario.provenance import provenance_lines, split_provenance
 from cosim.scenario.tomlfile import (
     MAX_DEPTH,
     deeper_than,
@@ -134,6 +135,7 @@ def section_types() -> dict[str, type[Any]]:
 
 
 def _build(raw: dict[str, Any], origin: str, origins: dict[tuple[str, str], str]) -> Scenario:
+    raw, resolved_with = split_provenance(raw, origin, origins)
     registry = section_registry()
     for section in raw:
         if section not in registry:
@@ -160,7 +162,7 @@ def _build(raw: dict[str, Any], origin: str, origins: dict[tuple[str, str], str]
             build(cls, table, section=section, origins=key_origins, default_origin=origin),
             key_origins,
         )
-    return Scenario(built, source=origin)
+    return Scenario(built, source=origin, resolved_with=resolved_with)
 
 
 def _resolve_paths(section: Any, origins: Mapping[str, str]) -> Any:
@@ -220,12 +222,19 @@ def toml_value(value: Any) -> str:
     raise TypeError(f"cannot write {type(value).__name__} to TOML")
 
 
-def dump_scenario(scenario: Scenario) -> str:
+def dump_scenario(scenario: Scenario, *, provenance: Mapping[str, str] | None = None) -> str:
     """The fully resolved scenario as TOML: every section, every key.
 
     Loading the text back gives an equal :class:`Scenario`.
+
+    Args:
+        scenario: the scenario.
+        provenance: the packages a run of it used, by version (a run folder's
+            ``scenario.toml``): written first, as a ``[provenance]`` table.
     """
     lines = [f"# resolved from {scenario.source}"]
+    if provenance:
+        lines += ["", *provenance_lines(provenance)]
     for name, section in scenario.sections.items():
         lines.append("")
         lines.append(f"[{name}]")

@@ -72,10 +72,13 @@ class Scenario:
     Attributes:
         sections: section name -> its settings, in file order (core sections first).
         source: the file or preset it was loaded from (for messages and provenance).
+        resolved_with: the file's ``[provenance]``: package -> the version a run used (not
+            a setting: see :mod:`cosim.scenario.provenance`).
     """
 
     sections: Mapping[str, Any] = field(default_factory=dict)
     source: str = field(default="<defaults>", compare=False)
+    resolved_with: Mapping[str, str] = field(default_factory=dict, compare=False)
     _by_type: Mapping[type[Any], Any] = field(
         default_factory=dict, init=False, repr=False, compare=False
     )
@@ -93,7 +96,7 @@ class Scenario:
 
     def __reduce__(self) -> tuple[Any, ...]:
         # the mapping proxy does not pickle: studies send scenarios to worker processes
-        return (Scenario, (dict(self.sections), self.source))
+        return (Scenario, (dict(self.sections), self.source, dict(self.resolved_with)))
 
     def section(self, kind: type[S]) -> S:
         """The section of type ``kind``.
@@ -183,7 +186,7 @@ class Scenario:
 
     def with_section(self, name: str, section: Any) -> Scenario:
         """Return a copy with section ``name`` replaced."""
-        return Scenario({**self.sections, name: section}, self.source)
+        return Scenario({**self.sections, name: section}, self.source, self.resolved_with)
 
     def with_seed(self, seed: int) -> Scenario:
         """Return a copy with another seed."""

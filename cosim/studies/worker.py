@@ -129,7 +129,7 @@ def run_one(job: Job) -> Outcome:
     row = row_cells(job)
     summary = result.summary
     for key, value in summary.items():
-        if key not in ("scenario", "source", "seed"):
+        if key not in ("scenario", "source", "seed", "plugins"):  # plugins: a list, no metric
             row[key] = value
     row.update(status="ok", error="", wall_time_s=summary["wall_time_s"])
     wanted = (
