@@ -39,8 +39,8 @@ def split_provenance(
     Args:
         raw: the file's tables.
         origin: the file (for messages).
-        origins: where overrides came from, by (section, key): ``--set provenance.x`` is no
-            setting.
+        origins: where keys came from, by (section, key): an override's origin ends with
+            its dotted key (``--set provenance.x``), and ``[provenance]`` is no setting.
 
     Raises:
         ConfigError: ``provenance`` is no table of ``package = "version"``, or is set by an
@@ -48,7 +48,10 @@ def split_provenance(
     """
     sections = {name: table for name, table in raw.items() if name != PROVENANCE}
     table = raw.get(PROVENANCE, {})
-    overridden = next((o for (s, _), o in origins.items() if s == PROVENANCE), None)
+    overridden = next(
+        (o for (s, k), o in origins.items() if s == PROVENANCE and o.endswith(f" {s}.{k}")),
+        None,
+    )  # a file's key (from an extended file too) is named by the file alone
     if overridden is not None:
         raise ConfigError(
             f"{overridden}: [provenance] says which packages a run used; it is no setting "

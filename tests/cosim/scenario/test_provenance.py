@@ -112,3 +112,12 @@ def test_a_version_installed_otherwise_or_a_package_gone_is_one_note():
         "note: runs/a/scenario.toml was resolved with cosim 0.0.1, nosuchkit 0.1.0; installed: "
         f"cosim {COSIM_VERSION}, no nosuchkit (results may differ from that run's)"
     )
+
+
+def test_a_provenance_key_a_file_set_is_no_override():
+    origins = {("provenance", "cosim"): "base.toml", ("robots", "count"): "--set robots.count"}
+    _, resolved = split_provenance({"provenance": {"cosim": "0.1.0"}}, "s.toml", origins)
+    assert resolved == {"cosim": "0.1.0"}
+    origins[("provenance", "cosim")] = "study provenance.cosim"
+    with pytest.raises(ConfigError, match=r"^study provenance\.cosim: \[provenance\] says"):
+        split_provenance({"provenance": {"cosim": "0.1.0"}}, "s.toml", origins)
