@@ -118,11 +118,22 @@ def installed() -> tuple[Lazy, ...]:
 
 def claims(group: str) -> dict[str, tuple[Lazy, ...]]:
     """Every name registered in ``group``, with every entry that registers it, in order."""
-    found: dict[str, tuple[Lazy, ...]] = {}
+    return dict(_grouped().get(group, {}))
+
+
+@cache
+def _grouped() -> dict[str, dict[str, tuple[Lazy, ...]]]:
+    found: dict[str, dict[str, tuple[Lazy, ...]]] = {}
     for lazy in installed():
-        if lazy.group == group:
-            found[lazy.name] = (*found.get(lazy.name, ()), lazy)
+        names = found.setdefault(lazy.group, {})
+        names[lazy.name] = (*names.get(lazy.name, ()), lazy)
     return found
+
+
+def rescan() -> None:
+    """Read the installed distributions again (a package installed meanwhile)."""
+    installed.cache_clear()
+    _grouped.cache_clear()
 
 
 def clashes(group: str) -> list[Clash]:

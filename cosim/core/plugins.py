@@ -23,6 +23,7 @@ from typing import Any
 
 from cosim.core.entrypoints import COSIM as COSIM  # cosim's own distribution
 from cosim.core.entrypoints import installed
+from cosim.core.entrypoints import rescan as rescan_entry_points
 from cosim.core.errors import CosimError
 
 COSIM_PACKAGES = ("cosim", "models", "adapters", "studies")
@@ -248,7 +249,7 @@ def installed_plugins() -> list[PluginInfo]:
 
 def rescan() -> None:
     """Read the installed packages' entry points again (a package installed meanwhile)."""
-    installed.cache_clear()
+    rescan_entry_points()
     _all_entries.cache_clear()
 
 

@@ -20,6 +20,7 @@ from typing import Any, TypeVar
 from cosim.core.errors import ConfigError, RegistryError
 from cosim.core.registry import Group, Registry
 from cosim.scenario.fields import key_bounds
+from cosim.scenario.provenance import PROVENANCE
 from cosim.scenario.sections import (
     LidarConfig,
     OdometryConfig,
@@ -36,9 +37,14 @@ CORE_SECTIONS = ("scenario", "world", "robots", "lidar", "odometry", "record")
 
 
 def _section_contract(name: str, loaded: Any) -> str | None:
-    """A section must be a dataclass type whose every field has a default."""
+    """A section must be a dataclass type whose every field has a default, named freely."""
     import dataclasses
 
+    if name == PROVENANCE:
+        return (
+            f"takes the name [{PROVENANCE}], which a run's scenario.toml keeps for the "
+            "packages the run used; register the section under another name"
+        )
     if not (isinstance(loaded, type) and dataclasses.is_dataclass(loaded)):
         return "is not a dataclass (declare the section's keys with param(default, doc))"
     try:

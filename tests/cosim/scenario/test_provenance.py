@@ -121,3 +121,21 @@ def test_a_provenance_key_a_file_set_is_no_override():
     origins[("provenance", "cosim")] = "study provenance.cosim"
     with pytest.raises(ConfigError, match=r"^study provenance\.cosim: \[provenance\] says"):
         split_provenance({"provenance": {"cosim": "0.1.0"}}, "s.toml", origins)
+
+
+def test_a_section_registered_as_provenance_is_refused_and_the_table_still_reads(tmp_path):
+    from dataclasses import dataclass
+
+    from cosim.core.errors import RegistryError
+    from cosim.core.registry import registered
+    from cosim.scenario.model import section_registry
+
+    @dataclass(frozen=True)
+    class Mine:
+        level: int = 1
+
+    with registered("cosim.sections", "provenance", Mine):
+        with pytest.raises(RegistryError, match=r"takes the name \[provenance\], which a run"):
+            section_registry().get("provenance")
+        path = _write(tmp_path, '[provenance]\ncosim = "0.1.0"\n')
+        assert dict(cosim.load_scenario(path).resolved_with) == {"cosim": "0.1.0"}
