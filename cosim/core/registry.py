@@ -28,7 +28,7 @@ from dataclasses import dataclass, replace
 from functools import cache
 from typing import Any, Generic, TypeVar
 
-from cosim.core.entrypoints import Clash, Lazy, clashes, entries, registered_once
+from cosim.core.entrypoints import Clash, Lazy, claims, clashes, entries, registered_once
 from cosim.core.errors import RegistryError
 from cosim.core.plugins import KINDS, PluginInfo, note_given
 
@@ -106,8 +106,11 @@ def installed_groups() -> list[Group]:
 
 
 def registry_names() -> list[str]:
-    """The entry-point groups of every registry (``cosim.registries``), none imported."""
-    return list(_entry_points(REGISTRIES))
+    """The entry-point groups of every registry (``cosim.registries``), none imported.
+
+    A group two packages register is named too (:func:`group_named` refuses it).
+    """
+    return list(claims(REGISTRIES))
 
 
 @cache

@@ -139,6 +139,7 @@ def test_a_group_with_a_name_registered_twice_refuses_to_load_but_lists_the_rest
 
 def test_a_registry_two_packages_register_is_refused_by_name(tmp_path):
     from cosim.core.registry import group_named
+    from tests.conftest import cosim_main
     from tests.packages import on_path, write_package
 
     registries = {"cosim.registries": {"cosim.planners": "clashkit.contract:PLANNERS"}}
@@ -149,6 +150,13 @@ def test_a_registry_two_packages_register_is_refused_by_name(tmp_path):
             with pytest.raises(RegistryError, match=r"'cosim\.planners' is registered by cosim"):
                 group_named("cosim.planners")
             assert group_named("cosim.controllers").words == "local controller"
+            done = cosim_main("plugins", "planner")  # named, then refused in one line
+            assert done.returncode == 2 and done.stderr.count("\n") == 1
+            assert "'cosim.planners' is registered by cosim" in done.stderr
+            listing = cosim_main("plugins")  # every other registry, and the clash
+            assert listing.returncode == 2
+            assert "registries (cosim.registries): 1 clashing\n  cosim.planners" in listing.stdout
+            assert "local controllers (cosim.controllers): 1" in listing.stdout
     finally:
         group_named.cache_clear()
 
