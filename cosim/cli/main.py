@@ -431,22 +431,10 @@ def _cmd_scenarios(_args: argparse.Namespace) -> int:
 
 
 def _cmd_plugins(args: argparse.Namespace) -> int:
-    from cosim.cli.plugins import CLASH, group_clashes, plugin_lines
+    from cosim.cli.plugins import list_plugins
     from cosim.core.registry import group_named
 
-    groups = [group_named(kind) for kind in args.kinds] or None
-    for line in plugin_lines(groups):
-        print(line)
-    clashes = group_clashes(groups)
-    if clashes:
-        names = ", ".join(f"{c.group} {c.name!r}" for c in clashes)
-        print(
-            f"cosim: error: registered twice ({CLASH} above): {names}; a run that uses such a "
-            "registry is refused until one package is uninstalled or renames its entry",
-            file=sys.stderr,
-        )
-        return EXIT_INPUT
-    return EXIT_OK
+    return list_plugins([group_named(kind) for kind in args.kinds] or None)
 
 
 def _cmd_standin(args: argparse.Namespace) -> int:

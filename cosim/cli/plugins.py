@@ -10,8 +10,10 @@ stops every run that uses the group, so ``cosim plugins`` then exits 2.
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Iterator, Sequence
 
+from cosim.cli.args import EXIT_INPUT
 from cosim.core.entrypoints import Clash, clashes, registered_once
 from cosim.core.registry import REGISTRIES, Group, Plugin, group_named
 
@@ -60,6 +62,22 @@ def plugin_lines(groups: Sequence[Group] | None = None) -> Iterator[str]:
             yield f"  {p.name:<{name_width}}  {package:<{package_width}}  {said}"
         yield from (_clash_line(c, name_width) for c in twice)
         yield ""
+
+
+def list_plugins(groups: Sequence[Group] | None = None) -> int:
+    """Print ``cosim plugins``' lines; the exit status: 2 when a name is registered twice."""
+    for line in plugin_lines(groups):
+        print(line)
+    found = group_clashes(groups)
+    if not found:
+        return 0
+    names = ", ".join(f"{c.group} {c.name!r}" for c in found)
+    print(
+        f"cosim: error: registered twice ({CLASH} above): {names}; a run that uses such a "
+        "registry is refused until one package is uninstalled or renames its entry",
+        file=sys.stderr,
+    )
+    return EXIT_INPUT
 
 
 def _clash_line(clash: Clash, width: int) -> str:
