@@ -287,7 +287,11 @@ def build_parser() -> argparse.ArgumentParser:
         ),
     )
     _scenario_argument(check)
-    check.add_argument("--print", action="store_true", help="print the fully resolved scenario")
+    check.add_argument(
+        "--print",
+        action="store_true",
+        help="print the fully resolved scenario (without [provenance]: nothing ran)",
+    )
 
     world = commands.add_parser(
         "world",
@@ -464,9 +468,11 @@ def build_parser() -> argparse.ArgumentParser:
         "is registered in it",
         description=(
             "List what installed packages register, cosim's own built-ins beside any plugin's: "
-            "each entry with the package it comes from and a one-line description. A plugin "
-            "that cannot be loaded is listed with the reason (it stops no run that does not "
-            "use it)."
+            "each entry with the package and version it comes from and a one-line description. "
+            "A plugin that cannot be loaded is listed with the reason (it stops no run that "
+            "does not use it). A name two packages register in one registry is listed once, "
+            "marked CLASH, with both packages: it stops every run that uses that registry, so "
+            "the command then exits 2."
         ),
     )
     listing.add_argument(

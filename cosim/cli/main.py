@@ -31,6 +31,7 @@ from cosim.scenario import (
     preset_names,
     preset_summary,
 )
+from cosim.scenario.provenance import provenance_note
 
 
 def _count(value: Any) -> str:
@@ -86,11 +87,16 @@ if TYPE_CHECKING:
 
 
 def _load(args: argparse.Namespace) -> Scenario:
+    """The scenario of ``args``; a note on stderr when its ``[provenance]`` is not installed."""
     overrides: dict[str, Any] = {}
     for text in args.overrides:
         key, value = parse_override(text)
         overrides[key] = value
-    return load_scenario(args.scenario, overrides)
+    scenario = load_scenario(args.scenario, overrides)
+    note = provenance_note(scenario.source, scenario.resolved_with)
+    if note is not None:
+        print(note, file=sys.stderr)
+    return scenario
 
 
 def _describe(scenario: Scenario) -> str:
@@ -434,12 +440,10 @@ def _cmd_scenarios(_args: argparse.Namespace) -> int:
 
 
 def _cmd_plugins(args: argparse.Namespace) -> int:
-    from cosim.cli.plugins import plugin_lines
+    from cosim.cli.plugins import list_plugins
     from cosim.core.registry import group_named
 
-    for line in plugin_lines([group_named(kind) for kind in args.kinds] or None):
-        print(line)
-    return EXIT_OK
+    return list_plugins([group_named(kind) for kind in args.kinds] or None)
 
 
 def _cmd_standin(args: argparse.Namespace) -> int:

@@ -15,15 +15,17 @@ entry a test registers with :meth:`~cosim.core.registry.Registry.with_entry`) is
 
 from __future__ import annotations
 
+import re
+from collections.abc import Iterable
 from dataclasses import dataclass, replace
 from functools import cache
-from importlib.metadata import distributions
 from typing import Any
 
+from cosim.core.entrypoints import COSIM as COSIM  # cosim's own distribution
+from cosim.core.entrypoints import installed
+from cosim.core.entrypoints import rescan as rescan_entry_points
 from cosim.core.errors import CosimError
 
-COSIM = "cosim"
-"""cosim's own distribution: its entries are built-ins, its faults are cosim's bugs."""
 COSIM_PACKAGES = ("cosim", "models", "adapters", "studies")
 """The import packages of cosim's distribution."""
 GROUP_PREFIX = "cosim."
@@ -188,7 +190,7 @@ def plugin_of(obj: Any) -> PluginInfo | None:
     module = module if isinstance(module, str) else cls.__module__
     qualname = getattr(obj, "__qualname__", None) if callable(obj) else None
     target = f"{module}:{qualname if isinstance(qualname, str) else cls.__qualname__}"
-    exact = _entries_by_target().get(target) or _GIVEN.get(target)
+    exact = _entries_by_target(_all_entries()).get(target) or _GIVEN.get(target)
     if exact is not None:
         return exact
     found = plugin_of_module(module)
@@ -198,66 +200,96 @@ def plugin_of(obj: Any) -> PluginInfo | None:
 
 
 def _installed_owner(module: str) -> PluginInfo | None:
-    by_module = _entries_by_module()
+    entries = _all_entries()
+    by_module = _entries_by_module(entries)
     parts = module.split(".")
-    for depth in range(len(parts), 0, -1):
-        entries = by_module.get(".".join(parts[:depth]))
-        if entries:
-            if depth == len(parts) and len(entries) == 1:
-                return entries[0]
-            first = entries[0]
-            return PluginInfo(first.package, first.version, target=module)
     top = parts[0]
-    if top in COSIM_PACKAGES:
-        return PluginInfo(COSIM, _version(COSIM), target=module)
-    package = _packages_by_top().get(top)
+    if top in COSIM_PACKAGES:  # cosim's code is cosim's, whatever another package names
+        exact = [info for info in by_module.get(module, ()) if info.builtin]
+        return exact[0] if len(exact) == 1 else PluginInfo(COSIM, _version(COSIM), target=module)
+    for depth in range(len(parts), 0, -1):
+        found = _claimants(by_module.get(".".join(parts[:depth]), ()), top)
+        if found:
+            if depth == len(parts) and len(found) == 1:
+                return found[0]
+            return PluginInfo(found[0].package, found[0].version, target=module)
+    package = _packages_by_top(entries).get(top)
     if package is not None:
         return PluginInfo(package[0], package[1], target=module)
     return None
 
 
+def _claimants(infos: Iterable[PluginInfo], top: str) -> list[PluginInfo]:
+    """Of the entries naming a module under ``top``, those of the package that ships it.
+
+    Two packages may name one module (a plugin registering another's class under a name of
+    its own, or under the same name: a clash); the code is the package's named after the
+    module's top-level package (``labkit`` for ``labkit.auction``; cosim for its own),
+    else the first package's in registry order.
+    """
+    found = list(infos)
+    if top in COSIM_PACKAGES:
+        return [info for info in found if info.builtin]
+    owners = [info for info in found if _normalized(info.package) == _normalized(top)]
+    return owners or found
+
+
+def _normalized(name: str) -> str:
+    return re.sub(r"[-_.]+", "_", name).lower()
+
+
 def installed_plugins() -> list[PluginInfo]:
-    """Every entry of every ``cosim.*`` group installed packages declare (cosim's included)."""
-    return [info for infos in _entries_by_module().values() for info in infos]
+    """Every entry of every ``cosim.*`` group installed packages declare (cosim's included).
+
+    cosim's first, then other packages' by package name; a name two packages register in
+    one group (a clash) is listed for both.
+    """
+    return list(_all_entries())
+
+
+def rescan() -> None:
+    """Read the installed packages' entry points again (a package installed meanwhile)."""
+    rescan_entry_points()
+    _all_entries.cache_clear()
 
 
 @cache
-def _entries_by_module() -> dict[str, list[PluginInfo]]:
+def _entries_by_module(entries: tuple[PluginInfo, ...]) -> dict[str, list[PluginInfo]]:
     by_module: dict[str, list[PluginInfo]] = {}
-    for info in _all_entries():
+    for info in entries:
         module = info.target.split(":", 1)[0]
         by_module.setdefault(module, []).append(info)
     return by_module
 
 
 @cache
-def _entries_by_target() -> dict[str, PluginInfo]:
-    return {info.target: info for info in _all_entries()}
+def _entries_by_target(entries: tuple[PluginInfo, ...]) -> dict[str, PluginInfo]:
+    by_target: dict[str, list[PluginInfo]] = {}
+    for info in entries:
+        by_target.setdefault(info.target, []).append(info)
+    found = {
+        t: _claimants(infos, t.split(".", 1)[0].split(":", 1)[0]) for t, infos in by_target.items()
+    }
+    return {target: infos[0] for target, infos in found.items() if infos}
 
 
 @cache
-def _packages_by_top() -> dict[str, tuple[str, str]]:
-    tops: dict[str, tuple[str, str]] = {}
-    for info in _all_entries():
-        tops.setdefault(info.target.split(".", 1)[0].split(":", 1)[0], (info.package, info.version))
-    return tops
+def _packages_by_top(entries: tuple[PluginInfo, ...]) -> dict[str, tuple[str, str]]:
+    by_top: dict[str, list[PluginInfo]] = {}
+    for info in entries:
+        by_top.setdefault(info.target.split(".", 1)[0].split(":", 1)[0], []).append(info)
+    found = {top: _claimants(infos, top) for top, infos in by_top.items()}
+    return {top: (infos[0].package, infos[0].version) for top, infos in found.items() if infos}
 
 
 @cache
 def _all_entries() -> tuple[PluginInfo, ...]:
-    found, seen = [], set()
-    for dist in distributions():
-        package = str(dist.metadata["Name"])
-        key = package.lower().replace("-", "_")
-        if key in seen:  # the same distribution twice on the path: the first is imported
-            continue
-        seen.add(key)
-        for point in dist.entry_points:
-            if point.group.startswith(GROUP_PREFIX):
-                found.append(
-                    PluginInfo(package, str(dist.version), point.group, point.name, point.value)
-                )
-    return tuple(found)
+    """Every entry of a ``cosim.*`` group, in registry order (cosim's first)."""
+    return tuple(
+        PluginInfo(lazy.package, lazy.version, lazy.group, lazy.name, lazy.value)
+        for lazy in installed()
+        if lazy.group.startswith(GROUP_PREFIX)
+    )
 
 
 @cache

@@ -14,7 +14,9 @@ group, so that ``cosim plugins`` and the references find every one, a plugin pac
 new kinds included. A registry reads the names of its group from the installed packages'
 metadata and imports an entry only when it is asked for, so a broken plugin is named
 when, and only when, a run uses it. An unknown name is refused with the registered names
-and the nearest ones.
+and the nearest ones. A name two packages both register in one group (a plugin's
+``greedy`` beside cosim's) stops the group from loading, naming both
+(:class:`~cosim.core.entrypoints.Clash`): which one a scenario means cannot be told.
 """
 
 from __future__ import annotations
@@ -22,13 +24,13 @@ from __future__ import annotations
 import contextlib
 import difflib
 from collections.abc import Callable, Iterable, Iterator, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cache
-from importlib.metadata import entry_points
 from typing import Any, Generic, TypeVar
 
+from cosim.core.entrypoints import Clash, Lazy, claims, clashes, entries, registered_once
 from cosim.core.errors import RegistryError
-from cosim.core.plugins import KINDS, note_given
+from cosim.core.plugins import KINDS, PluginInfo, note_given
 
 T = TypeVar("T")
 
@@ -74,22 +76,41 @@ class Group:
 
         Entries of cosim itself come first, in declaration order; then other packages' by
         package name.
+
+        Raises:
+            RegistryError: a name is registered twice in the group (by two packages, or by
+                a plugin and cosim): which one a scenario means cannot be told.
         """
         return Registry(self, {**_entry_points(self.entry_points), **_given(self.entry_points)})
+
+    def listed(self) -> Registry[Any]:
+        """For listings (``cosim plugins``): the entries whose name no other registers.
+
+        A name registered twice is left out here and said by :meth:`clashes`.
+        """
+        return Registry(self, {**registered_once(self.entry_points), **_given(self.entry_points)})
+
+    def clashes(self) -> list[Clash]:
+        """The names of this group that more than one installed package registers."""
+        return clashes(self.entry_points)
 
 
 def installed_groups() -> list[Group]:
     """Every group registered in ``cosim.registries`` (cosim's first), loaded.
 
     Raises:
-        RegistryError: for a registered group that cannot be loaded or is no :class:`Group`.
+        RegistryError: for a registered group that cannot be loaded or is no :class:`Group`,
+            or a group's name registered twice.
     """
     return [group_named(name) for name in _entry_points(REGISTRIES)]
 
 
 def registry_names() -> list[str]:
-    """The entry-point groups of every registry (``cosim.registries``), none imported."""
-    return list(_entry_points(REGISTRIES))
+    """The entry-point groups of every registry (``cosim.registries``), none imported.
+
+    A group two packages register is named too (:func:`group_named` refuses it).
+    """
+    return list(claims(REGISTRIES))
 
 
 @cache
@@ -103,10 +124,14 @@ def group_named(entry_points: str) -> Group:
         RegistryError: for a group that is not registered in ``cosim.registries``, cannot
             be loaded, or is no :class:`Group` for that entry-point group.
     """
-    lazy = _entry_points(REGISTRIES).get(entry_points)
+    clash = next((c for c in clashes(REGISTRIES) if c.name == entry_points), None)
+    if clash is not None:
+        raise RegistryError(str(clash))
+    lazy = registered_once(REGISTRIES).get(entry_points)
     if lazy is None:
         raise RegistryError(
-            f"no registry {entry_points!r}" + suggest_names(entry_points, _entry_points(REGISTRIES))
+            f"no registry {entry_points!r}"
+            + suggest_names(entry_points, registered_once(REGISTRIES))
         )
     where = f"registry {entry_points!r} ({lazy.value}, package {lazy.package})"
     try:
@@ -121,36 +146,6 @@ def group_named(entry_points: str) -> Group:
 
 
 @dataclass(frozen=True)
-class Lazy:
-    """An entry point, imported on first use.
-
-    Wrapped, because the entry points of ``importlib.metadata`` and of its backport
-    ``importlib_metadata`` (which some packages install into the import system) are
-    different classes with the same attributes.
-
-    Attributes:
-        point: the entry point (``load()``, ``name``, ``value``, ``dist``).
-    """
-
-    point: Any
-
-    def load(self) -> Any:
-        """Import the entry point's object."""
-        return self.point.load()
-
-    @property
-    def value(self) -> str:
-        """``module:attribute``."""
-        return str(self.point.value)
-
-    @property
-    def package(self) -> str:
-        """The distribution that declares the entry point."""
-        dist = getattr(self.point, "dist", None)
-        return str(dist.name) if dist is not None else "?"
-
-
-@dataclass(frozen=True)
 class Plugin:
     """One registered entry, as ``cosim plugins`` lists it.
 
@@ -161,6 +156,7 @@ class Plugin:
         target: ``module:attribute`` of the entry point.
         summary: the first line of its docstring.
         error: why it cannot be loaded, or None.
+        version: the package's version (``""`` for an entry given in code).
     """
 
     group: Group
@@ -169,6 +165,7 @@ class Plugin:
     target: str
     summary: str
     error: str | None = None
+    version: str = ""
 
 
 class Registry(Generic[T]):
@@ -209,6 +206,24 @@ class Registry(Generic[T]):
         if isinstance(entry, Lazy):
             return entry.package
         return "(given in code)"
+
+    def version(self, name: str) -> str:
+        """The version of the distribution that registers ``name`` (``""``: given in code)."""
+        entry = self._entries.get(name)
+        return entry.version if isinstance(entry, Lazy) else ""
+
+    def plugin(self, name: str) -> PluginInfo:
+        """Whose entry ``name`` is: its package, version and target, without importing it.
+
+        An entry given in code has no package (``""``), as :mod:`cosim.core.plugins` says.
+        """
+        entry = self._entries.get(name)
+        if entry is None:
+            raise self.unknown(name)
+        package = self.package(name) if isinstance(entry, Lazy) else ""
+        return PluginInfo(
+            package, self.version(name), self.group.entry_points, name, self.target(name)
+        )
 
     def target(self, name: str) -> str:
         """Where ``name`` comes from: ``module:attribute``."""
@@ -267,17 +282,16 @@ class Registry(Generic[T]):
         """Every entry with its package and one-line summary; broken ones with their error."""
         plugins = []
         for name in self.names():
+            row = Plugin(self.group, name, self.package(name), self.target(name), "")
+            row = replace(row, version=self.version(name))
             try:
                 loaded = self.get(name)
             except RegistryError as error:
-                plugins.append(
-                    Plugin(self.group, name, self.package(name), self.target(name), "", str(error))
-                )
+                plugins.append(replace(row, error=str(error)))
                 continue
             declared = getattr(loaded, "summary", None)
             doc = declared if isinstance(declared, str) else (loaded.__doc__ or "").strip()
-            summary = doc.splitlines()[0] if doc else ""
-            plugins.append(Plugin(self.group, name, self.package(name), self.target(name), summary))
+            plugins.append(replace(row, summary=doc.splitlines()[0] if doc else ""))
         return plugins
 
 
@@ -329,16 +343,13 @@ def registered(entry_points: str, name: str, entry: Any) -> Iterator[None]:
         _GIVEN[entry_points].pop(name, None)
 
 
-@cache
 def _entry_points(group: str) -> dict[str, Lazy]:
-    """A group's entry points, cosim's first, then other packages' by package name."""
-    found = [Lazy(point) for point in entry_points(group=group)]
-    ours = [p for p in found if p.package == "cosim"]
-    theirs = sorted((p for p in found if p.package != "cosim"), key=lambda p: p.package)
-    entries: dict[str, Lazy] = {}
-    for lazy in ours + theirs:
-        entries.setdefault(lazy.point.name, lazy)  # the first package to claim a name keeps it
-    return entries
+    """A group's entry points, cosim's first, then other packages' by package name.
+
+    Raises:
+        RegistryError: a name is registered twice in the group (see :class:`Clash`).
+    """
+    return entries(group)
 
 
 class AdapterRegistry(Registry[Any]):

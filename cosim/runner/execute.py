@@ -34,6 +34,7 @@ from cosim.runner.faults import (
     write_failure,
 )
 from cosim.runner.outfolder import prepare_out, write_run
+from cosim.runner.provenance import run_plugins
 from cosim.runner.result import RunResult
 from cosim.runner.stopping import CHECK_EVERY_S, RunStopped, StopRequest, signal_name
 from cosim.runner.watchdog import Watchdog
@@ -266,6 +267,7 @@ def _run_assembled(
         "seed": scenario.seed,
         "version": cosim_version(),
         "python": platform.python_version(),
+        "plugins": run_plugins(scenario, assembly),
         "sim_time_s": reached_s,
         "wall_time_s": round(wall_s, 4),
         "real_time_factor": round(reached_s / wall_s, 2) if wall_s > 0 else None,

@@ -1,13 +1,15 @@
 """A run's folder: what a run writes there, replacing an earlier run's, and writing it.
 
-A run writes ``summary.json``, ``scenario.toml``, ``tables/NAME.parquet`` (one per table),
-``bag/`` (``metadata.yaml`` and ``bag.mcap`` or ``bag.db3``), ``maps/NAME.yaml`` + ``.pgm``
-(``fleet`` and ``robot_N``), SUMO's files in ``sumo/`` and, drawn afterwards with
-``--figures``/``--gif``, ``figures/``. ``--force`` removes exactly those of an earlier run
-that this run writes again (the figures only when it draws them: figures made with
-``cosim plot`` stay otherwise) and leaves every other file where it is; a file in the way of
-the new results (a stranger in ``bag/``, which rosbags must create afresh; a folder named
-``summary.json``) is named in one line instead of being deleted.
+A run writes ``summary.json`` (with ``"plugins"``: whose code it ran, by package version),
+``scenario.toml`` (beginning with ``[provenance]``: those packages and versions),
+``tables/NAME.parquet`` (one per table), ``bag/`` (``metadata.yaml`` and ``bag.mcap`` or
+``bag.db3``), ``maps/NAME.yaml`` + ``.pgm`` (``fleet`` and ``robot_N``), SUMO's files in
+``sumo/`` and, drawn afterwards with ``--figures``/``--gif``, ``figures/``. ``--force``
+removes exactly those of an earlier run that this run writes again (the figures only when it
+draws them: figures made with ``cosim plot`` stay otherwise) and leaves every other file
+where it is; a file in the way of the new results (a stranger in ``bag/``, which rosbags
+must create afresh; a folder named ``summary.json``) is named in one line instead of being
+deleted.
 
 A run without ``--out`` writes to ``runs/NAME-seedN``, or, when that folder holds results
 already, to the first free ``runs/NAME-seedN-2``, ``-3``, ... (:func:`default_out`).
@@ -26,6 +28,7 @@ from typing import TYPE_CHECKING
 from adapters.world.files import write_map
 from cosim.core.errors import ExportError
 from cosim.recording.bag import BAG_DIR
+from cosim.runner.provenance import packages
 from cosim.scenario.loader import dump_scenario
 from models.geometry.occupancy import OccupancyGrid
 
@@ -208,7 +211,10 @@ def write_run(result: RunResult, out: Path, *, tables: bool = True) -> None:
         if partial.exists():
             shutil.rmtree(partial)
         partial.mkdir(parents=True)
-        (partial / "scenario.toml").write_text(dump_scenario(result.scenario), encoding="utf-8")
+        used = packages(result.summary.get("plugins", ()))
+        (partial / "scenario.toml").write_text(
+            dump_scenario(result.scenario, provenance=used), encoding="utf-8"
+        )
         if tables:
             (partial / "tables").mkdir()
             for name, frame in result.tables.items():

@@ -19,6 +19,7 @@ from cosim.core.errors import ConfigError, RegistryError
 from cosim.scenario.extends import resolve as resolve_extends
 from cosim.scenario.fields import build, show_name, show_value, suggest
 from cosim.scenario.model import Scenario, section_classes, section_registry
+from cosim.scenario.provenance import provenance_lines, split_provenance
 from cosim.scenario.tomlfile import (
     MAX_DEPTH,
     deeper_than,
@@ -154,7 +155,9 @@ def _build(
 
     ``origins`` names where each (section, key) came from and ``sections`` where each
     section did (a file of an ``extends`` chain, ``--set``); ``origin`` where neither says.
+    A ``[provenance]`` table is taken apart (:attr:`Scenario.resolved_with`), not a section.
     """
+    raw, resolved_with = split_provenance(raw, origin, origins)
     registry = section_registry()
     sections = sections or {}
     for section in raw:
@@ -185,7 +188,7 @@ def _build(
             build(cls, table, section=section, origins=key_origins, default_origin=where),
             key_origins,
         )
-    return Scenario(built, source=origin)
+    return Scenario(built, source=origin, resolved_with=resolved_with)
 
 
 def _resolve_paths(section: Any, origins: Mapping[str, str]) -> Any:
@@ -245,12 +248,19 @@ def toml_value(value: Any) -> str:
     raise TypeError(f"cannot write {type(value).__name__} to TOML")
 
 
-def dump_scenario(scenario: Scenario) -> str:
+def dump_scenario(scenario: Scenario, *, provenance: Mapping[str, str] | None = None) -> str:
     """The fully resolved scenario as TOML: every section, every key.
 
     Loading the text back gives an equal :class:`Scenario`.
+
+    Args:
+        scenario: the scenario.
+        provenance: the packages a run of it used, by version (a run folder's
+            ``scenario.toml``): written first, as a ``[provenance]`` table.
     """
     lines = [f"# resolved from {scenario.source}"]
+    if provenance:
+        lines += ["", *provenance_lines(provenance)]
     for name, section in scenario.sections.items():
         lines.append("")
         lines.append(f"[{name}]")

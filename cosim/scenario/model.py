@@ -20,6 +20,7 @@ from typing import Any, TypeVar
 from cosim.core.errors import ConfigError, RegistryError
 from cosim.core.registry import Group, Registry
 from cosim.scenario.fields import key_bounds
+from cosim.scenario.provenance import PROVENANCE
 from cosim.scenario.sections import (
     LidarConfig,
     OdometryConfig,
@@ -36,9 +37,14 @@ CORE_SECTIONS = ("scenario", "world", "robots", "lidar", "odometry", "record")
 
 
 def _section_contract(name: str, loaded: Any) -> str | None:
-    """A section must be a dataclass type whose every field has a default."""
+    """A section must be a dataclass type whose every field has a default, named freely."""
     import dataclasses
 
+    if name == PROVENANCE:
+        return (
+            f"takes the name [{PROVENANCE}], which a run's scenario.toml keeps for the "
+            "packages the run used; register the section under another name"
+        )
     if not (isinstance(loaded, type) and dataclasses.is_dataclass(loaded)):
         return "is not a dataclass (declare the section's keys with param(default, doc))"
     try:
@@ -72,10 +78,13 @@ class Scenario:
     Attributes:
         sections: section name -> its settings, in file order (core sections first).
         source: the file or preset it was loaded from (for messages and provenance).
+        resolved_with: the file's ``[provenance]``: package -> the version a run used (not
+            a setting: see :mod:`cosim.scenario.provenance`).
     """
 
     sections: Mapping[str, Any] = field(default_factory=dict)
     source: str = field(default="<defaults>", compare=False)
+    resolved_with: Mapping[str, str] = field(default_factory=dict, compare=False)
     _by_type: Mapping[type[Any], Any] = field(
         default_factory=dict, init=False, repr=False, compare=False
     )
@@ -93,7 +102,7 @@ class Scenario:
 
     def __reduce__(self) -> tuple[Any, ...]:
         # the mapping proxy does not pickle: studies send scenarios to worker processes
-        return (Scenario, (dict(self.sections), self.source))
+        return (Scenario, (dict(self.sections), self.source, dict(self.resolved_with)))
 
     def section(self, kind: type[S]) -> S:
         """The section of type ``kind``.
@@ -183,7 +192,7 @@ class Scenario:
 
     def with_section(self, name: str, section: Any) -> Scenario:
         """Return a copy with section ``name`` replaced."""
-        return Scenario({**self.sections, name: section}, self.source)
+        return Scenario({**self.sections, name: section}, self.source, self.resolved_with)
 
     def with_seed(self, seed: int) -> Scenario:
         """Return a copy with another seed."""

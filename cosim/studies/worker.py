@@ -173,7 +173,8 @@ def _outcome(
     row = row_cells(job)
     summary = result.summary
     for key, value in summary.items():
-        if key not in ("scenario", "source", "seed", "failed", "failure"):
+        # plugins: a list, no metric; failed, failure: said by the row's error and kind
+        if key not in ("scenario", "source", "seed", "failed", "failure", "plugins"):
             row[key] = value
     row.update(
         status="error" if error else "ok",

@@ -11,6 +11,7 @@ import json
 import os
 import subprocess
 import sys
+from importlib.metadata import version
 from pathlib import Path
 
 import pandas as pd
@@ -84,6 +85,15 @@ def test_a_run_with_labkits_protocol_controller_and_sensor_repeats_exactly(plugi
     resolved = (tmp_path / "a" / "scenario.toml").read_text()
     assert "[sequential_auction]\nsettle_rounds = 2" in resolved
     assert "[pure_pursuit]\ncruise_mps = 0.7" in resolved
+    assert f'[provenance]\ncosim = "{version("cosim")}"\nlabkit = "0.1.0"\n' in resolved
+    used = {(p["group"], p["name"]): p["package"] for p in summary["plugins"]}
+    for chosen in (
+        ("cosim.protocols", "sequential_auction"),
+        ("cosim.controllers", "pure_pursuit"),
+        ("cosim.adapters", "rangefinder"),
+        ("cosim.sections", "rangefinder"),
+    ):
+        assert used[chosen] == "labkit", chosen
     info = cosim(plugins, "bag", "info", str(tmp_path / "a" / "bag"))
     assert "sensor_msgs/msg/Range" in info.stdout
     assert "labkit_msgs/msg/BidTable" in info.stdout
@@ -92,6 +102,7 @@ def test_a_run_with_labkits_protocol_controller_and_sensor_repeats_exactly(plugi
         plugins, "run", str(tmp_path / "a" / "scenario.toml"), "--out", str(tmp_path / "b")
     )
     assert again.returncode == 0, again.stderr
+    assert "note:" not in again.stderr  # the same versions are installed
     for table in ("poses", "tasks", "assignments", "ranges", "navigation"):
         pd.testing.assert_frame_equal(
             pd.read_parquet(tmp_path / "a" / "tables" / f"{table}.parquet").drop(

@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from tests.conftest import REPO, cosim_main
+from tests.packages import env_with, on_path, write_package
 
 BROKEN_ENTRY_POINTS = """[cosim.protocols]
 broken_auction = brokenplug.missing:Auction
@@ -130,3 +131,64 @@ def test_a_run_that_uses_a_broken_plugin_is_refused_in_one_line_naming_it(
     assert fragment in done.stderr
     assert done.stderr.count("\n") == 1 and "Traceback" not in done.stderr
     assert not (tmp_path / "r").exists()
+
+
+GREEDY = '"""A greedy of its own."""\n\n\nclass Greedy:\n    """Mine."""\n\n    name = "greedy"\n'
+CLASH = (
+    "cosim.protocols: 'greedy' is registered by cosim (adapters.assignment.protocols:Greedy) "
+    "and by clashkit 0.1.0 (clashkit.greedy:Greedy); uninstall one or rename it"
+)
+
+
+@pytest.fixture
+def clashing(tmp_path: Path) -> Path:
+    """A site with clashkit 0.1.0, whose protocol takes cosim's name ``greedy``."""
+    site = tmp_path / "site"
+    entry_points = {
+        "cosim.protocols": {"greedy": "clashkit.greedy:Greedy", "mine": "clashkit.greedy:Greedy"}
+    }
+    return write_package(site, "clashkit", "0.1.0", entry_points, {"clashkit/greedy.py": GREEDY})
+
+
+@pytest.mark.parametrize("command", ["check", "run"])
+def test_a_run_using_a_registry_with_a_clash_is_refused_in_one_line_naming_both_packages(
+    clashing: Path, tmp_path: Path, command: str
+):
+    with on_path(clashing):
+        done = cosim_main(command, "warehouse-random", *_out(command, tmp_path))
+    assert done.returncode == 2
+    assert done.stderr == f"cosim: error: {CLASH}\n"
+    assert not (tmp_path / "r").exists()
+
+
+def _out(command: str, tmp_path: Path) -> list[str]:
+    return ["--out", str(tmp_path / "r"), "--duration-s", "1"] if command == "run" else []
+
+
+def test_cosim_plugins_lists_a_clash_marked_among_the_entries_and_exits_2(clashing: Path):
+    with on_path(clashing):
+        done = cosim_main("plugins", "protocol")
+    lines = done.stdout.splitlines()
+    assert lines[0] == "assignment protocols (cosim.protocols): 5"  # 4 names, 1 clash
+    [marked] = [line for line in lines if "CLASH" in line]
+    assert marked.split()[:2] == ["greedy", "CLASH:"]
+    assert marked.endswith(CLASH.split("'greedy' is ", 1)[1])
+    mine = next(line for line in lines if line.split()[:1] == ["mine"])
+    assert mine.split()[1:3] == ["clashkit", "0.1.0"]
+    assert done.returncode == 2
+    assert done.stderr.startswith("cosim: error: registered twice (CLASH above): cosim.protocols")
+    assert done.stderr.count("\n") == 1
+
+
+def test_cosim_plugins_names_the_clash_in_a_fresh_process_too(clashing: Path):
+    done = cosim(env_with(clashing), "plugins", "protocol")
+    assert done.returncode == 2, done.stderr
+    assert "  greedy" in done.stdout and "CLASH: registered by cosim" in done.stdout
+
+
+def test_cosim_plugins_shows_each_entrys_package_version():
+    from importlib.metadata import version
+
+    done = cosim_main("plugins", "planner")
+    line = next(li for li in done.stdout.splitlines() if li.split()[:1] == ["astar"])
+    assert line.split()[1:3] == ["cosim", version("cosim")]

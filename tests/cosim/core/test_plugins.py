@@ -4,7 +4,14 @@ import pickle
 
 from adapters.navigation.contract import CONTROLLERS
 from adapters.navigation.stack import NavigationAdapter
-from cosim.core.plugins import PluginError, PluginInfo, plugin_of, plugin_of_module, refuse
+from cosim.core.plugins import (
+    PluginError,
+    PluginInfo,
+    installed_plugins,
+    plugin_of,
+    plugin_of_module,
+    refuse,
+)
 from cosim.core.registry import AdapterRegistry
 
 
@@ -90,3 +97,48 @@ def test_a_plugin_error_crosses_processes_whole():
 def test_refuse_names_the_owner_of_the_value():
     error = refuse(GivenController(), "returned a command of shape (3,); expected (2,)")
     assert "'given'" in str(error) and "shape (3,)" in str(error)
+
+
+def test_a_plugin_naming_cosims_code_does_not_make_it_the_plugins(tmp_path):
+    from adapters.assignment.protocols import Greedy
+    from tests.packages import on_path, write_package
+
+    claims = {
+        "cosim.protocols": {"greedy": "adapters.assignment.protocols:Greedy"},  # a clash
+        "cosim.loss_models": {"mine": "models.network.loss:check_probability"},
+    }
+    write_package(tmp_path, "clashkit", "0.1.0", claims)
+    with on_path(tmp_path):
+        info = plugin_of(Greedy)
+        assert info is not None and info.builtin and info.name == "greedy"
+        module = plugin_of_module("models.network.loss")
+        assert module is not None and module.builtin
+        assert {i.package for i in installed_plugins() if i.name == "greedy"} == {
+            "cosim",
+            "clashkit",
+        }
+
+
+def test_each_of_two_packages_clashing_on_a_name_owns_its_own_code(tmp_path):
+    from tests.packages import on_path, write_package
+
+    code = '"""Steers."""\n\n\nclass Steer:\n    """Steers."""\n\n    name = "steer"\n'
+    for kit in ("akit", "bkit"):
+        write_package(
+            tmp_path,
+            kit,
+            "1.0",
+            {"cosim.controllers": {"steer": f"{kit}.steer:Steer"}},
+            {f"{kit}/steer.py": code},
+        )
+    # a third package (listed first) naming akit's class: it stays akit's
+    write_package(tmp_path, "aakit", "1.0", {"cosim.controllers": {"c": "akit.steer:Steer"}})
+    with on_path(tmp_path):
+        import akit.steer
+        import bkit.steer
+
+        first, second = plugin_of(akit.steer.Steer), plugin_of(bkit.steer.Steer)
+        assert first is not None and (first.package, first.name) == ("akit", "steer")
+        assert second is not None and (second.package, second.name) == ("bkit", "steer")
+        module = plugin_of_module("akit.steer")
+        assert module is not None and module.package == "akit"

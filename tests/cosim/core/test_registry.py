@@ -119,3 +119,56 @@ def test_an_entry_given_in_code_cannot_take_a_registered_name():
     taken = r"'dwa' is registered in cosim\.controllers already"
     with pytest.raises(RegistryError, match=taken), registered("cosim.controllers", "dwa", 1):
         pass
+
+
+GREEDY = {"cosim.protocols": {"greedy": "clashkit.greedy:Greedy"}}
+
+
+def test_a_group_with_a_name_registered_twice_refuses_to_load_but_lists_the_rest(tmp_path):
+    from adapters.assignment.contract import PROTOCOLS
+    from tests.packages import on_path, write_package
+
+    write_package(tmp_path, "clashkit", "0.1.0", GREEDY)
+    with on_path(tmp_path):
+        with pytest.raises(RegistryError, match=r"^cosim\.protocols: 'greedy' is registered by"):
+            PROTOCOLS.installed()
+        assert "greedy" not in PROTOCOLS.listed() and "hungarian" in PROTOCOLS.listed()
+        assert [c.name for c in PROTOCOLS.clashes()] == ["greedy"]
+    assert "greedy" in PROTOCOLS.installed()  # uninstalled: cosim's greedy is back
+
+
+def test_a_registry_two_packages_register_is_refused_by_name(tmp_path):
+    from cosim.core.registry import group_named
+    from tests.conftest import cosim_main
+    from tests.packages import on_path, write_package
+
+    registries = {"cosim.registries": {"cosim.planners": "clashkit.contract:PLANNERS"}}
+    write_package(tmp_path, "clashkit", "0.1.0", registries)
+    group_named.cache_clear()
+    try:
+        with on_path(tmp_path):
+            with pytest.raises(RegistryError, match=r"'cosim\.planners' is registered by cosim"):
+                group_named("cosim.planners")
+            assert group_named("cosim.controllers").words == "local controller"
+            done = cosim_main("plugins", "planner")  # named, then refused in one line
+            assert done.returncode == 2 and done.stderr.count("\n") == 1
+            assert "'cosim.planners' is registered by cosim" in done.stderr
+            listing = cosim_main("plugins")  # every other registry, and the clash
+            assert listing.returncode == 2
+            assert "registries (cosim.registries): 1 clashing\n  cosim.planners" in listing.stdout
+            assert "local controllers (cosim.controllers): 1" in listing.stdout
+    finally:
+        group_named.cache_clear()
+
+
+def test_an_entry_says_its_package_version_and_target_without_importing_it(tmp_path):
+    from adapters.assignment.contract import PROTOCOLS
+    from tests.packages import on_path, write_package
+
+    write_package(tmp_path, "lazykit", "0.3.0", {"cosim.protocols": {"lazy": "lazykit.x:Lazy"}})
+    with on_path(tmp_path):
+        info = PROTOCOLS.installed().plugin("lazy")  # lazykit.x does not exist: not imported
+    assert (info.package, info.version, info.target) == ("lazykit", "0.3.0", "lazykit.x:Lazy")
+    assert (info.group, info.name) == ("cosim.protocols", "lazy")
+    builtin = PROTOCOLS.installed().plugin("hungarian")
+    assert builtin.builtin and builtin.version

@@ -160,10 +160,13 @@ def test_tables_are_the_same_with_and_without_a_bag(tmp_path):
     assert with_bag.bag is not None and without.bag is None
     for name, frame in without.deterministic_tables().items():
         assert with_bag.deterministic_tables()[name].equals(frame), name
-    machine = {"wall_time_s", "real_time_factor"}
+    machine = {"wall_time_s", "real_time_factor", "plugins"}
     assert {k: v for k, v in with_bag.summary.items() if k not in machine} == {
         k: v for k, v in without.summary.items() if k not in machine
     }
+    # the bag's run also ran the ROS interface that fills it, and says so
+    extra = [p for p in with_bag.summary["plugins"] if p not in without.summary["plugins"]]
+    assert [(p["group"], p["name"]) for p in extra] == [("cosim.adapters", "ros_interface")]
 
 
 def test_a_sqlite3_bag_with_compressed_messages_reads_back(tmp_path):

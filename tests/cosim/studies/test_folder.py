@@ -207,7 +207,8 @@ def test_a_full_disk_mid_study_exits_2_in_one_line_and_keeps_the_finished_runs(
     tmp_path, tmpfs, monkeypatch
 ):
     path = small_study(tmp_path, seeds="[1, 2, 3, 4]")
-    # 4 KiB pages: the plan takes one, a run three (row, summary, scenario): two runs fit
+    # 4 KiB pages: the plan takes one, a run four (row, a summary whose plugins take two,
+    # scenario): one run fits
     disk = tmpfs(32)
     if disk is None:
         _full_after(monkeypatch, folder_module, "_write_run_files", 2)
@@ -236,8 +237,9 @@ def test_a_full_disk_mid_study_exits_2_in_one_line_and_keeps_the_finished_runs(
 @pytest.mark.slow
 def test_a_disk_too_full_for_the_results_keeps_every_run_for_resume(tmp_path, tmpfs, monkeypatch):
     path = small_study(tmp_path)
-    # a plan page and three runs of three pages fit; results.parquet (some 35 KiB) does not
-    disk = tmpfs(48)
+    # a plan page and three runs of four pages (summary.json's plugins take two) fit;
+    # results.parquet (some 35 KiB) does not
+    disk = tmpfs(56)
     if disk is None:
         _full_after(monkeypatch, pd.DataFrame, "to_parquet", 0, path_at=1)
     out = (disk or tmp_path) / "out"

@@ -47,6 +47,7 @@ def test_a_run_returns_its_row_its_resolved_scenario_and_only_the_tables_asked_f
     assert outcome.row["sim_time_s"] == 2.0
     assert outcome.row["wall_time_s"] == outcome.summary["wall_time_s"]
     assert "scenario" not in outcome.row  # the study's own columns say which
+    assert "plugins" not in outcome.row and outcome.summary["plugins"][0]["package"] == "cosim"
     assert "seed = 3" in outcome.scenario_toml
     assert set(outcome.tables) == {"poses"}
     poses = pd.read_parquet(io.BytesIO(outcome.tables["poses"]))
