@@ -137,11 +137,17 @@ duration_s = 3.0
 @pytest.fixture(scope="module")
 def faultykit(tmp_path_factory):
     """An environment where faultykit 0.3.1 is installed, with its failing sensor adapter."""
-    from tests.plugin_site import plugin_site
+    from tests.packages import env_with, write_package
 
-    entry_points = "[cosim.adapters]\nfaulty_sensor = faultykit.sensor:Sensor\n"
     site = tmp_path_factory.mktemp("site")
-    return plugin_site(site, "faultykit", "0.3.1", entry_points, {"sensor.py": SENSOR})
+    write_package(
+        site,
+        "faultykit",
+        "0.3.1",
+        {"cosim.adapters": {"faulty_sensor": "faultykit.sensor:Sensor"}},
+        {"faultykit/__init__.py": "", "faultykit/sensor.py": SENSOR},
+    )
+    return env_with(site)
 
 
 def _cosim(env, *args, cwd):
