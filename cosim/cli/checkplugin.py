@@ -3,7 +3,8 @@
 One line per check (``ok``, ``FAIL`` or ``skip``, its name, what was found or why), then
 a last line counting them. Exit status: 0 every check passed or did not apply; 3 a check
 failed (the plugin's code broke its contract or its group's rules, as ``cosim run`` says
-of a plugin whose code failed); 2 an unknown or ambiguous NAME, or a bad ``--set``.
+of a plugin whose code failed; a ``--set`` value its scenario refuses fails the
+``scenario`` check); 2 an unknown or ambiguous NAME, or a ``--set`` of no registered key.
 
 The checks themselves are :mod:`cosim.testing.checks`; nothing of them is imported until
 the command runs, so that ``cosim --help`` stays fast.
@@ -32,7 +33,7 @@ DESCRIPTION = (
 )
 EPILOG = (
     "Exit status: 0 every check passed (or did not apply: skip), 3 a check failed, "
-    "2 an unknown or ambiguous NAME or a bad --set."
+    "2 an unknown or ambiguous NAME or a --set of no registered key."
 )
 
 
@@ -70,9 +71,10 @@ def add_arguments(parser: argparse.ArgumentParser, *, duration_s: Callable[[str]
 def check_plugin_command(args: argparse.Namespace) -> int:
     """Run every check on ``args.name``, print a line each; the exit status."""
     from cosim.scenario import parse_override
-    from cosim.testing.checks import check_plugin, find_entry, plugin_words
+    from cosim.testing.checks import check_plugin, find_entry, known_keys, plugin_words
 
     overrides: dict[str, Any] = dict(parse_override(text) for text in args.overrides)
+    known_keys(overrides)
     target = find_entry(args.name)
     print(f"checking {plugin_words(target)}", flush=True)
     outcomes = []

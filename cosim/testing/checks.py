@@ -26,7 +26,7 @@ from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from cosim.core.errors import RegistryError
+from cosim.core.errors import ConfigError, RegistryError
 from cosim.core.plugins import plugin_of
 from cosim.core.registry import (
     ADAPTERS,
@@ -36,8 +36,8 @@ from cosim.core.registry import (
     installed_groups,
     suggest_names,
 )
-from cosim.reference.keys_page import UNITS, unit_of
-from cosim.scenario.model import SECTIONS, section_registry
+from cosim.scenario.fields import UNITS, field_names, suggest, unit_of
+from cosim.scenario.model import SECTIONS, section_classes, section_registry
 from cosim.testing.trials import trial_checks
 from cosim.testing.verdicts import Outcome, fail, ok, skip
 
@@ -207,6 +207,29 @@ def _is_number(value: Any) -> bool:
 def _stem(key: str) -> str:
     suffix = next((s for s in UNITS if key.endswith(s)), "")
     return key[: len(key) - len(suffix)] if suffix else key
+
+
+def known_keys(overrides: Mapping[str, Any]) -> None:
+    """Refuse a ``section.key`` no registered section has (the user's typo, not the plugin's).
+
+    Values are checked with the scenario of the run (the ``scenario`` check): whether a
+    value fits may depend on the entry chosen.
+
+    Raises:
+        ConfigError: naming the key and the nearest ones.
+    """
+    classes = section_classes()
+    for dotted in overrides:
+        section, _, key = dotted.partition(".")
+        if section not in classes:
+            raise ConfigError(
+                f"--set {dotted}: no section [{section}]" + suggest(section, list(classes))
+            )
+        keys = field_names(classes[section])
+        if key not in keys:
+            raise ConfigError(
+                f"--set {dotted}: [{section}] has no key {key!r}" + suggest(key, keys)
+            )
 
 
 # -- all of them --------------------------------------------------------------------------------

@@ -48,7 +48,12 @@ def listed(items: Sequence[str]) -> str:
 
 def seconds(value: Any) -> str:
     """A time in seconds (a float, or a table's cell) as messages show it (``9.00636 s``)."""
-    return f"{float(value):.9g} s"
+    return f"{_decimal(float(value))} s"
+
+
+def _decimal(value: float) -> str:
+    """Seconds to the nanosecond, without trailing zeros (``8.806359972``, ``9.006``)."""
+    return f"{value:.9f}".rstrip("0").rstrip(".") if np.isfinite(value) else str(value)
 
 
 # -- latency -----------------------------------------------------------------------------------
@@ -220,8 +225,9 @@ def assert_order(
         after = rows[rows > last]
         if len(after) == 0:
             said = f"step {number} {_shown(step)}"
+            steps_before = "step 1" if number == 2 else f"steps 1-{number - 1}"
             before = (
-                f" (steps 1-{number - 1} matched at t = {', '.join(f'{t:.9g}' for t in matched)} s)"
+                f" ({steps_before} matched at t = {', '.join(map(_decimal, matched))} s)"
                 if matched
                 else ""
             )
@@ -229,7 +235,7 @@ def assert_order(
                 raise AssertionError(f"{said}: no row of tables/{table} matches it{before}")
             raise AssertionError(
                 f"{said} does not come after step {number - 1}{before}: it matches only "
-                f"earlier, at t = {', '.join(f'{t:.9g}' for t in times_s[rows][:LISTED])} s"
+                f"earlier, at t = {', '.join(map(_decimal, times_s[rows][:LISTED]))} s"
             )
         last = int(after[0])
         matched.append(float(times_s[last]))

@@ -167,14 +167,16 @@ def raised(error: BaseException) -> str:
     if isinstance(error, CosimError):
         return " ".join(str(error).split("\n"))
     said = f"{type(error).__name__}: {' '.join(str(error).split())}"
-    ours = [
-        (frame, line)
-        for frame, line in traceback.walk_tb(error.__traceback__)
-        if plugin_of_module(str(frame.f_globals.get("__name__", ""))) is not None
-    ]
-    if ours:
-        frame, line = ours[-1]
-        said += f" (raised in {frame.f_globals['__name__']}, line {line}, {frame.f_code.co_name})"
+    ours: list[tuple[str, int, str]] = []  # frames in cosim's code
+    theirs: list[tuple[str, int, str]] = []  # frames in a plugin's
+    for frame, line in traceback.walk_tb(error.__traceback__):
+        module = str(frame.f_globals.get("__name__", ""))
+        owner = plugin_of_module(module)
+        if owner is not None:
+            (ours if owner.builtin else theirs).append((module, line, frame.f_code.co_name))
+    if theirs or ours:
+        module, line, function = (theirs or ours)[-1]  # the plugin's own line, if on the way
+        said += f" (raised in {module}, line {line}, {function})"
     return said
 
 
@@ -202,8 +204,8 @@ def round_trip(name: str, overrides: Mapping[str, Any]) -> Outcome:
     try:
         scenario = load_scenario(PRESET, dict(overrides))
         again = scenario_from_text(dump_scenario(scenario), "scenario.toml")
-    except CosimError as error:
-        return fail("scenario", str(error))
+    except Exception as error:  # the section's own code (problems(), its values) included
+        return fail("scenario", f"[{name}] does not go through scenario.toml: {raised(error)}")
     if name not in scenario.sections:
         return fail("scenario", f"{PRESET} has no [{name}] section")
     if again.sections.get(name) != scenario.sections[name]:
