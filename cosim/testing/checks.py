@@ -71,7 +71,8 @@ def registry_of(group: Group) -> Registry[Any]:
 def find_entry(text: str) -> Target:
     """The entry ``text`` names: ``NAME``, or ``GROUP:NAME`` when several groups hold NAME.
 
-    ``GROUP`` is an entry-point group (``cosim.drivers``), its short name (``drivers``) or
+    A name held by one group and by ``cosim.sections`` is the plugin, not its settings
+    section (which its ``settings`` check reads). ``GROUP`` is an entry-point group (``cosim.drivers``), its short name (``drivers``) or
     its singular (``driver``).
 
     Raises:
@@ -91,6 +92,9 @@ def find_entry(text: str) -> Target:
     if not holders:
         everything = sorted({n for g in groups for n in registry_of(g).names()})
         raise RegistryError(f"no plugin {name!r} in any registry" + suggest_names(name, everything))
+    plugins = [(g, r) for g, r in holders if g != SECTIONS]
+    if len(plugins) == 1:  # a section of a plugin's own name is its settings, checked with it
+        holders = plugins
     if len(holders) > 1:
         where = ", ".join(g.entry_points for g, _ in holders)
         example = f"{holders[0][0].entry_points}:{name}"

@@ -48,6 +48,11 @@ def test_a_name_several_groups_hold_is_refused_naming_them_and_how_to_choose():
     assert find_entry("drivers:navigation").group.entry_points == "cosim.drivers"
 
 
+def test_a_name_held_by_a_plugin_and_its_settings_section_is_the_plugin():
+    assert find_entry("network").group.entry_points == "cosim.adapters"
+    assert find_entry("sections:network").group == SECTIONS
+
+
 def test_an_unknown_name_or_group_is_refused_with_the_nearest_ones():
     with pytest.raises(RegistryError, match=r"^no plugin 'greedyy' in any registry; did you "
                        r"mean 'greedy'\?"):  # fmt: skip
