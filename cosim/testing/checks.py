@@ -160,7 +160,8 @@ def check_settings(target: Target) -> Outcome:
     count = len(dataclasses.fields(section))
     return ok(
         "settings",
-        f"[{target.name}] {count} keys: builds from its defaults, every key documented, "
+        f"[{target.name}] {count} key{'' if count == 1 else 's'}: builds from its defaults, "
+        "every key documented, "
         "units in the names",
     )
 
