@@ -72,8 +72,8 @@ def find_entry(text: str) -> Target:
     """The entry ``text`` names: ``NAME``, or ``GROUP:NAME`` when several groups hold NAME.
 
     A name held by one group and by ``cosim.sections`` is the plugin, not its settings
-    section (which its ``settings`` check reads). ``GROUP`` is an entry-point group (``cosim.drivers``), its short name (``drivers``) or
-    its singular (``driver``).
+    section (which its ``settings`` check reads). ``GROUP`` is an entry-point group
+    (``cosim.drivers``), its short name (``drivers``) or its singular (``driver``).
 
     Raises:
         RegistryError: no such group or name, or a name several groups hold (listing them).
@@ -88,9 +88,10 @@ def find_entry(text: str) -> Target:
                 f"{text!r}: no registry {group_text!r}" + suggest_names(group_text, shorts)
             )
         groups = chosen
-    holders = [(g, registry_of(g)) for g in groups if name in registry_of(g)]
+    registries = [(g, registry_of(g)) for g in groups]
+    holders = [(g, r) for g, r in registries if name in r]
     if not holders:
-        everything = sorted({n for g in groups for n in registry_of(g).names()})
+        everything = sorted({n for _, r in registries for n in r.names()})
         raise RegistryError(f"no plugin {name!r} in any registry" + suggest_names(name, everything))
     plugins = [(g, r) for g, r in holders if g != SECTIONS]
     if len(plugins) == 1:  # a section of a plugin's own name is its settings, checked with it

@@ -157,9 +157,13 @@ def trial_checks(
 def try_run(scenario: Scenario, duration_s: float) -> RunResult | Outcome:
     """The run's result, or the failed ``runs`` check naming what went wrong and where."""
     try:
-        return run(scenario, duration_s=duration_s)
+        result = run(scenario, duration_s=duration_s)
     except Exception as error:  # the plugin's fault, whatever it raised, is this check's
         return fail("runs", raised(error))
+    ended = result.summary.get("failed") or result.summary.get("stopped")
+    if ended:  # a run that ended early and kept what ran is no run to the end
+        return fail("runs", f"the run ended at t = {result.summary['sim_time_s']:g} s: {ended}")
+    return result
 
 
 def raised(error: BaseException) -> str:

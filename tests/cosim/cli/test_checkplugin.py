@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -56,7 +57,7 @@ def test_every_built_in_passes_check_plugin(entry, needs):
     done = cosim_main("check-plugin", entry, *args)
     assert done.returncode == 0, done.stdout + done.stderr
     lines = done.stdout.splitlines()
-    assert lines[0].startswith("checking ") and lines[0].endswith("cosim 0.1.0)")
+    assert re.fullmatch(r"checking .* \(.*, cosim [\w.+]+\)", lines[0]), lines[0]
     assert all(line.split()[0] in ("ok", "skip") for line in lines[1:-1]), done.stdout
     assert lines[-1].startswith(f"{entry.split(':')[1]}: ") and "checks passed" in lines[-1]
 

@@ -196,3 +196,13 @@ def test_a_summary_entry_that_is_not_flat_fails_summary():
     said = lines(ADAPTERS, "nested", Nested)
     assert "FAIL summary: summary entries that are no number, string, true/false or null: " \
            "nested_counts = {'a': 1}" in said  # fmt: skip
+
+
+def test_a_run_that_ended_early_keeping_what_ran_fails_runs(monkeypatch):
+    from cosim.testing import trials
+    from tests.cosim.testing.conftest import made_run
+
+    ended = made_run({}, sim_time_s=3.5, failed="robot_2 went silent")
+    monkeypatch.setattr(trials, "run", lambda scenario, duration_s: ended)
+    said = lines(PROTOCOLS, "nobody", Nobody)
+    assert said[1:] == ["FAIL runs: the run ended at t = 3.5 s: robot_2 went silent"]
