@@ -12,11 +12,11 @@ from pathlib import Path
 from typing import NoReturn
 
 from adapters.physical.standin_options import add_arguments as add_standin_arguments
+from cosim.cli.checkplugin import add_arguments as add_check_plugin_arguments
+from cosim.cli.exits import EXIT_INPUT
 from cosim.cli.hostname import host_argument
 from cosim.scenario.fields import key_bounds
 from cosim.scenario.sections import ScenarioSection
-
-EXIT_INPUT = 2
 
 
 class Parser(argparse.ArgumentParser):
@@ -483,4 +483,8 @@ def build_parser() -> argparse.ArgumentParser:
         help="only these registries, by entry-point group (cosim.planners), short name "
         "(planners) or singular (planner); default: all",
     )
+    checking = commands.add_parser(
+        "check-plugin", help="run cosim's checks of its built-ins on a plugin, one line each"
+    )
+    add_check_plugin_arguments(checking, duration_s=_duration_s)
     return parser

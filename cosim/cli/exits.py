@@ -18,13 +18,14 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from cosim.cli.args import EXIT_INPUT
 from cosim.core.errors import CosimError
 
 EXIT_OK = 0
 """Done."""
 EXIT_BUG = 1
 """cosim's own code failed: a bug, to report with its traceback."""
+EXIT_INPUT = 2
+"""Invalid input: a file, a key, a flag (one line, no traceback)."""
 EXIT_PLUGIN = 3
 """A plugin's code failed: raised, hung, or handed back a value cosim refuses."""
 EXIT_RUNS_FAILED = 4
@@ -38,7 +39,7 @@ EXIT_STATUSES = {
     "motion-capture server) failed mid-run",
     EXIT_PLUGIN: "a plugin's code failed (raised, hung past scenario.hang_timeout_s, or "
     "handed back a value cosim refuses): one line naming it; its traceback in the run "
-    "folder's failure.txt, the results so far kept",
+    "folder's failure.txt, the results so far kept; for `cosim check-plugin`, a check failed",
     EXIT_RUNS_FAILED: "a study finished, but some of its runs failed (report.md lists them, "
     "each run's folder holds its failure.txt)",
     130: "interrupted (Ctrl-C); 128 + N for signal N: what ran is kept",

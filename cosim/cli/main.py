@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from cosim.cli.args import build_parser
+from cosim.cli.checkplugin import check_plugin_command
 from cosim.cli.exits import (
     EXIT_BUG,
     EXIT_OK,
@@ -462,6 +463,7 @@ COMMANDS = {
     "plot": _cmd_plot,
     "scenarios": _cmd_scenarios,
     "plugins": _cmd_plugins,
+    "check-plugin": check_plugin_command,
     "standin": _cmd_standin,
 }
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 import sys
 from collections.abc import Iterator, Sequence
 
-from cosim.cli.args import EXIT_INPUT
+from cosim.cli.exits import EXIT_INPUT
 from cosim.core.entrypoints import Clash, clashes, registered_once
 from cosim.core.registry import REGISTRIES, Group, Plugin, group_named
 

@@ -7,30 +7,10 @@ import inspect
 from typing import Any, get_args, get_type_hints
 
 from cosim.core.registry import group_named
-from cosim.scenario.fields import Bounds, describe, implicit_bounds
+from cosim.scenario.fields import UNITS as UNITS  # the reference's unit column, re-exported
+from cosim.scenario.fields import Bounds, describe, implicit_bounds, unit_of
 from cosim.scenario.loader import toml_value
 from cosim.scenario.model import section_classes, section_registry
-
-UNITS = {
-    "_mps2": "m/s²",
-    "_radps2": "rad/s²",
-    "_mps": "m/s",
-    "_radps": "rad/s",
-    "_mbps": "Mbit/s",
-    "_hz": "Hz",
-    "_ms": "ms",
-    "_s": "s",
-    "_m": "m",
-    "_deg": "deg",
-    "_rad": "rad",
-    "_prob": "probability",
-}
-"""Unit by key suffix (the project's naming rule: units in names)."""
-
-
-def unit_of(key: str) -> str:
-    """The unit a key's name carries, or an empty string."""
-    return next((unit for suffix, unit in UNITS.items() if key.endswith(suffix)), "")
 
 
 def _cell(text: str) -> str:

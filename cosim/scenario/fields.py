@@ -253,6 +253,28 @@ def suggest(name: str, options: list[str]) -> str:
 
 T = TypeVar("T")
 
+UNITS = {
+    "_mps2": "m/s²",
+    "_radps2": "rad/s²",
+    "_mps": "m/s",
+    "_radps": "rad/s",
+    "_mbps": "Mbit/s",
+    "_hz": "Hz",
+    "_ms": "ms",
+    "_s": "s",
+    "_m": "m",
+    "_deg": "deg",
+    "_rad": "rad",
+    "_prob": "probability",
+}
+"""Unit by key suffix (the project's naming rule: units in names)."""
+
+
+def unit_of(key: str) -> str:
+    """The unit a key's name carries, or an empty string."""
+    return next((unit for suffix, unit in UNITS.items() if key.endswith(suffix)), "")
+
+
 SMALLEST = {"_hz": 1e-3, "_ms": 1e-3, "_s": 1e-6}
 """Smallest positive value of a rate or time (by unit suffix) where only ``> 0`` is declared:
 a rate of 1e-308 Hz is a period no clock can hold."""
@@ -388,6 +410,7 @@ def docs(cls: type[Any]) -> dict[str, str]:
 
 
 __all__ = [
+    "UNITS",
     "Bounds",
     "Problem",
     "build",
@@ -400,4 +423,5 @@ __all__ = [
     "model_problem",
     "param",
     "suggest",
+    "unit_of",
 ]

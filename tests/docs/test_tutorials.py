@@ -2,7 +2,9 @@
 
 Every code block with a ``title="path"`` is a file of the tutorial's package; the package is
 installed into a folder of its own (``pip install --target``) and used through cosim's
-command line, so a tutorial that stops working fails here, not for its reader.
+command line, so a tutorial that stops working fails here, not for its reader. The plugin
+tutorials end with tests written with cosim's testing kit (``tests/test_*.py`` blocks): they
+run here with pytest, and ``cosim check-plugin`` on the plugin.
 """
 
 from __future__ import annotations
@@ -63,6 +65,24 @@ def cosim(
     )  # fmt: skip
 
 
+def check_and_test(env: dict[str, str], source: Path, name: str, tests: int) -> None:
+    """The page's plugin passes `cosim check-plugin`, and its kit-written tests pass.
+
+    The tests run as the reader runs them, with pytest; cosim's pytest plugin is asked for
+    by name (the shared environment's metadata predates its pytest11 entry point).
+    """
+    checked = cosim(env, "check-plugin", name)
+    assert checked.returncode == 0, checked.stdout + checked.stderr
+    assert checked.stdout.splitlines()[-1].startswith(f"{name}: ")
+    ran = subprocess.run(
+        [sys.executable, "-m", "pytest", "-q", "-p", "cosim.testing.plugin",
+         "-p", "no:cacheprovider", str(source / "tests")],
+        capture_output=True, text=True, env=env, cwd=source, timeout=600,
+    )  # fmt: skip
+    assert ran.returncode == 0, ran.stdout + ran.stderr
+    assert f"{tests} passed" in ran.stdout
+
+
 def test_the_adapter_tutorials_battery_installs_runs_and_takes_its_settings(tmp_path):
     source, env = install("write-an-adapter.md", tmp_path)
     listed = cosim(env, "plugins", "adapter", "section")
@@ -89,6 +109,7 @@ def test_the_adapter_tutorials_battery_installs_runs_and_takes_its_settings(tmp_
                          env=plain, timeout=300)  # fmt: skip
     assert ran.returncode == 0, ran.stderr
     assert 0.0 < float(ran.stdout.split()[-1]) < 1.0
+    check_and_test(env, source, "battery", tests=3)
 
 
 def test_the_protocol_tutorials_cheapest_pairs_runs_alone_and_in_its_study(tmp_path):
@@ -109,10 +130,11 @@ def test_the_protocol_tutorials_cheapest_pairs_runs_alone_and_in_its_study(tmp_p
     assert study.returncode == 0, study.stderr
     rows = pd.read_parquet(tmp_path / "s" / "results.parquet")
     assert len(rows) == 8 and set(rows["status"]) == {"ok"}
+    check_and_test(env, source, "cheapest_pairs", tests=3)
 
 
 def test_the_controller_tutorials_turn_then_go_drives_robots_to_their_goals(tmp_path):
-    _, env = install("write-a-controller.md", tmp_path)
+    source, env = install("write-a-controller.md", tmp_path)
     out = tmp_path / "run"
     done = cosim(env, "run", "warehouse-random", "--set", "navigation.controller=turn_then_go",
                  "--set", "turn_then_go.heading_gain=3", "--duration-s", "60",
@@ -122,6 +144,7 @@ def test_the_controller_tutorials_turn_then_go_drives_robots_to_their_goals(tmp_
     assert summary["arrivals"] >= 4
     refused = cosim(env, "check", "warehouse-random", "--set", "turn_then_go.stop_m=0")
     assert refused.returncode == 2 and "expected a number > 0" in refused.stderr
+    check_and_test(env, source, "turn_then_go", tests=3)
 
 
 def test_the_study_tutorial_runs_and_its_analysis_reads_the_results(tmp_path):

@@ -199,3 +199,20 @@ def test_a_pose_source_of_labkits_tracks_every_robot_at_its_rate(plugins, tmp_pa
     # a robot at full speed may pass the jump tolerance)
     taken = summary["mocap_poses"] + summary["mocap_rejected_jumps"]
     assert taken == summary["gnss_fixes"] and summary["mocap_poses"] >= 0.95 * taken
+
+
+LABKITS = [
+    "sequential_auction", "pure_pursuit", "rangefinder", "every_nth", "wired", "gnss",
+    "sections:sequential_auction", "sections:pure_pursuit", "sections:rangefinder",
+    "sections:every_nth", "sections:wired", "sections:gnss",
+]  # fmt: skip
+
+
+@pytest.mark.parametrize("name", LABKITS)
+def test_cosim_check_plugin_passes_on_every_plugin_of_labkit(plugins, name):
+    done = cosim(plugins, "check-plugin", name)
+    assert done.returncode == 0, done.stdout + done.stderr
+    first, *checks, last = done.stdout.splitlines()
+    assert first.startswith("checking ") and first.endswith(", labkit 0.1.0)")
+    assert all(line.startswith("ok   ") for line in checks), done.stdout
+    assert "checks passed" in last and "skipped" not in last

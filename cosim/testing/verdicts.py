@@ -1,0 +1,53 @@
+"""How one check of ``cosim check-plugin`` came out: ok, FAIL or skip, and why, in one line."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import Enum
+
+
+class Verdict(Enum):
+    """How a check came out."""
+
+    OK = "ok"
+    FAIL = "FAIL"
+    SKIP = "skip"
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """One check of one entry.
+
+    Attributes:
+        check: the check's name (``contract``, ``runs``, ``assigns``).
+        verdict: ok, FAIL or skip.
+        detail: what was found (for ok), why it failed, or why it was skipped: one line.
+    """
+
+    check: str
+    verdict: Verdict
+    detail: str
+
+    @property
+    def failed(self) -> bool:
+        """Whether the check failed."""
+        return self.verdict is Verdict.FAIL
+
+    def line(self) -> str:
+        """``ok   contract: ...``, ``FAIL assigns: ...``: how ``cosim check-plugin`` prints it."""
+        return f"{self.verdict.value:<4} {self.check}: {self.detail}"
+
+
+def ok(check: str, detail: str) -> Outcome:
+    """A passed check."""
+    return Outcome(check, Verdict.OK, detail)
+
+
+def fail(check: str, why: str) -> Outcome:
+    """A failed check."""
+    return Outcome(check, Verdict.FAIL, why)
+
+
+def skip(check: str, why: str) -> Outcome:
+    """A check that does not apply."""
+    return Outcome(check, Verdict.SKIP, why)
