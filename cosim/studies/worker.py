@@ -16,7 +16,7 @@ from typing import Any
 
 from cosim.core.errors import CosimError
 from cosim.runner.execute import execute
-from cosim.runner.result import RunResult
+from cosim.runner.result import RECORD_KEYS, RunResult
 from cosim.scenario import Scenario, load_scenario
 from cosim.scenario.loader import dump_scenario
 
@@ -173,8 +173,8 @@ def _outcome(
     row = row_cells(job)
     summary = result.summary
     for key, value in summary.items():
-        # plugins: a list, no metric; failed, failure: said by the row's error and kind
-        if key not in ("scenario", "source", "seed", "failed", "failure", "plugins"):
+        # records are no metrics; failed: said by the row's error and failure_kind
+        if key not in ("scenario", "source", "seed", "failed", *RECORD_KEYS):
             row[key] = value
     row.update(
         status="error" if error else "ok",

@@ -24,7 +24,7 @@ from cosim.core.plugins import plugin_of_module
 from cosim.core.registry import Group
 from cosim.runner.assembly import check_scenario
 from cosim.runner.execute import run
-from cosim.runner.result import RunResult
+from cosim.runner.result import RECORD_KEYS, RunResult
 from cosim.scenario import Scenario, dump_scenario, load_scenario, scenario_from_text
 from cosim.scenario.model import SECTIONS, section_classes
 from cosim.testing.outcomes import assert_same_run
@@ -185,11 +185,15 @@ def raised(error: BaseException) -> str:
 
 
 def flat_summary(result: RunResult) -> Outcome:
-    """``summary.json`` is flat: numbers, strings, true/false or null, by key."""
+    """``summary.json`` is flat: numbers, strings, true/false or null, by key.
+
+    Besides cosim's own records (:data:`~cosim.runner.result.RECORD_KEYS`).
+    """
     nested = [
         f"{key} = {value!r}"
         for key, value in result.summary.items()
-        if not (value is None or isinstance(value, bool | int | float | str))
+        if key not in RECORD_KEYS
+        and not (value is None or isinstance(value, bool | int | float | str))
     ]
     if nested:
         return fail(
