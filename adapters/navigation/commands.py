@@ -84,8 +84,7 @@ def checked_commands(
             i = int(np.flatnonzero(~np.isfinite(values))[0])
             raise refuse(
                 controller,
-                f"returned {what} {values[i]} for {names[i]!r}; expected a finite number "
-                f"({unit})",
+                f"returned {what} {values[i]} for {names[i]!r}; expected a finite number ({unit})",
                 doing=DOING,
             )
     forward, backward = limits.max_speed_mps, -limits.max_reverse_mps
@@ -106,7 +105,8 @@ def _numbers(controller: Any, what: str, values: Any, n: int) -> FloatArray:
             f"returned {what} of dtype {values.dtype}; expected real numbers (float)",
             doing=DOING,
         )
-    return values.astype(np.float64, copy=False)
+    floats: FloatArray = values.astype(np.float64, copy=False)
+    return floats
 
 
 def _shape(controller: Any, what: str, values: Any, n: int) -> None:
