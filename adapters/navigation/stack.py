@@ -208,7 +208,9 @@ class NavigationAdapter:
             self.pose, vel, carrots, goals, points, start, moving, discs, disc_start, now_ns
         )
         returned = parts.control.commands(inputs)
-        v, w, blocked, clipped = checked_commands(parts.control, returned, parts.names, parts.limits)
+        v, w, blocked, clipped = checked_commands(
+            parts.control, returned, parts.names, parts.limits
+        )
         self.clipped += clipped
         caps = speed_caps(moving, n, parts.radius_m, parts.limits.max_speed_mps, parts.traffic)
         return np.minimum(v, caps), w, blocked
