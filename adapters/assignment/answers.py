@@ -14,12 +14,13 @@ the robot, the value and what was expected, instead of leaving robots standing:
 - ``task()``: None, or the index of one of the epoch's tasks (``0 <= index < len(tasks)``;
   a negative index is no task's);
 - ``view()``: robot index -> task index, both in range, no task given to two robots;
+- ``rounds``, ``cost()``: an int, a number (m);
 - ``orders()``: robot name -> ``(task id, cost in m)``, only for the free robots asked
   about, each task id one of the open tasks offered (or -1: none) that the robot may serve,
   no task ordered to two robots, the cost a finite number.
 
-Each check is a few comparisons per answer; none touches the values of an answer it
-accepts.
+Each check is a few comparisons per answer; an answer it accepts keeps its value (numpy
+integers and booleans come back as Python's).
 """
 
 from __future__ import annotations
