@@ -18,6 +18,13 @@ free robot's task.
 The messages a protocol exchanges are :class:`~cosim.core.messages.Message` subclasses with
 ``epoch`` (int) and ``robot`` (the sender's name) attributes, a ROS 2 type name and a CDR
 encoding (so the network model sizes them and bags record them).
+
+Every answer is checked where it enters the task assignment
+(:mod:`adapters.assignment.answers`): one cosim cannot act on (a task index out of the
+epoch's range, a message of another type than :attr:`~AssignmentProtocolType.message`, a
+``decided`` that is no bool, orders for robots that are not free or tasks not offered, a
+task ordered twice, ...) ends the run with a :class:`~cosim.core.plugins.PluginError`
+naming the protocol, the robot, the value and what was expected.
 """
 
 from __future__ import annotations
@@ -83,19 +90,23 @@ class ProtocolAgent(Protocol):
         """Run one round on the messages received since the last one.
 
         Returns:
-            The message to broadcast (None: nothing), and whether this robot's state
-            changed (a changed state is broadcast at once; an unchanged one every
+            The message to broadcast (None: nothing), exactly of the protocol's
+            ``message`` type, and whether this robot's state changed (a bool; a changed
+            state is broadcast at once, an unchanged one every
             ``assignment.rebroadcast_s``).
         """
         ...
 
     @property
     def decided(self) -> bool:
-        """Whether the robot may act on :meth:`task` (it may still change its mind)."""
+        """Whether the robot may act on :meth:`task` (it may still change its mind): a bool."""
         ...
 
     def task(self) -> int | None:
-        """The index of the task this robot should serve, or None."""
+        """The index of the task this robot should serve in the epoch's tasks, or None.
+
+        An index is ``0 <= index < len(epoch.tasks)`` (an int; a negative one is refused).
+        """
         ...
 
     @property
@@ -108,7 +119,10 @@ class ProtocolAgent(Protocol):
         ...
 
     def view(self) -> dict[int, int]:
-        """This robot's view of the whole assignment (robot index -> task index)."""
+        """This robot's view of the whole assignment (robot index -> task index).
+
+        Indices in range, and no task given to two robots.
+        """
         ...
 
 
@@ -139,7 +153,11 @@ class AssignmentProtocolType(Protocol):
     def orders(
         self, tasks: Sequence[TaskInfo], poses: Mapping[str, tuple[float, float]]
     ) -> dict[str, tuple[int, float]]:
-        """Central protocols: each free robot's task id and cost (-1: none), from poses (m)."""
+        """Central protocols: each free robot's task id and cost (-1: none), from poses (m).
+
+        Only robots of ``poses`` (the free ones), each ordered to one of ``tasks`` it is
+        eligible for (or -1), no task to two robots, the cost a finite number (m).
+        """
         ...
 
     def summary(self) -> Mapping[str, Any]:

@@ -23,6 +23,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from adapters.assignment.answers import CheckedAgent, CheckedOrders
 from adapters.assignment.commitments import Commitments, RobotTasks
 from adapters.assignment.contract import (
     EpochView,
@@ -105,7 +106,7 @@ class DtaAdapter:
         )
         self.protocol = protocol_type(fleet_view)
         if protocol_type.central:
-            run.provide(CentralOrders(self.protocol))
+            run.provide(CentralOrders(CheckedOrders(self.protocol, self.names)))
         self.records = DtaRecords(
             run.recorder, self.names, compare=protocol_type.compare_to_optimum
         )
@@ -213,7 +214,10 @@ class DtaAdapter:
             or (t.task_id in robot.claims and robot.claims[t.task_id][0] != robot.name)
         )
         view = EpochView(problem, robot.index, robot.name, tasks.epoch, tasks.tasks, taken)
-        robot.protocol = self.protocol.agent(view)  # None: orders come from the base station
+        agent = self.protocol.agent(view)  # None: orders come from the base station
+        robot.protocol = (
+            None if agent is None else CheckedAgent(agent, self.protocol, view, len(self.names))
+        )
         self.records.epoch_seen(robot.index, tasks.epoch, tasks.stamp_ns, problem)
 
     def _problem(self, robot: RobotTasks, tasks: tuple[TaskInfo, ...]) -> AssignmentProblem:

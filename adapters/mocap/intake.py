@@ -15,11 +15,21 @@ one, which goes stale after ``mocap.max_age_ms``: its navigation stops it (and a
 stays where it was last seen). An accepted one is published on
 ``/<robot>/pose`` (``geometry_msgs/PoseStamped`` in ``map``) and, for a twin, becomes its
 ground truth.
+
+Those are *measurement* rejections: a real system sends NaN for a lost body, a stale or
+jumping pose, a body outside the room, and a robot's software must live with it. What is
+not a pose at all is a fault of the source's code and ends the run (a
+:class:`~cosim.core.plugins.PluginError` naming the source, the robot, the value and what
+was expected): a robot index that is not an int of the fleet, a stamp that is not an int
+(ns), coordinates that are not numbers (a string, None, an array; ``bool`` neither).
+Floats pass at the cost of one type comparison each.
 """
 
 from __future__ import annotations
 
 import math
+from numbers import Integral, Real
+from typing import Any
 
 from adapters.fleet.mirror import Mirrors
 from adapters.mocap.settings import MocapConfig
@@ -28,6 +38,7 @@ from adapters.mocap.topics import pose_topic
 from cosim.core.adapter import RunContext
 from cosim.core.hosts import HostId
 from cosim.core.messages import PoseStamped
+from cosim.core.plugins import PluginError, refuse
 from cosim.core.timebase import NS_PER_S
 from cosim.scenario.sections import RobotsConfig, WorldConfig
 from models.fleet.kinematics import FleetState
@@ -43,9 +54,11 @@ class PoseIntake:
     Args:
         run: the run.
         host: the host the poses are published from (the mocap server, or a robot).
+        source: the pose source class whose code submits (named in errors), or None.
     """
 
-    def __init__(self, run: RunContext, host: HostId) -> None:
+    def __init__(self, run: RunContext, host: HostId, source: Any = None) -> None:
+        self.source = source
         fleet = run.service(FleetState)
         robots = run.settings(RobotsConfig)
         self.run = run
@@ -106,7 +119,17 @@ class PoseIntake:
 
         Returns:
             Whether the pose was accepted.
+
+        Raises:
+            PluginError: ``index``, ``stamp_ns`` or the coordinates are not numbers of the
+                kind expected (see the module docstring).
         """
+        if type(index) is not int or not 0 <= index < len(self.names):
+            index = self._robot(index)
+        if type(stamp_ns) is not int:
+            stamp_ns = self._integer(index, stamp_ns)
+        if type(x_m) is not float or type(y_m) is not float or type(yaw_rad) is not float:
+            x_m, y_m, yaw_rad = self._numbers(index, x_m, y_m, yaw_rad)
         now = self.run.kernel.now_ns if now_ns is None else now_ns
         name = self.names[index]
         if not all(math.isfinite(v) for v in (x_m, y_m, yaw_rad)):
@@ -141,6 +164,34 @@ class PoseIntake:
             self.host if host is None else host,
         )
         return True
+
+    def _robot(self, index: Any) -> int:
+        integral = isinstance(index, Integral) and not isinstance(index, bool)
+        if integral and 0 <= int(index) < len(self.names):
+            return int(index)
+        expected = f"a robot index 0 to {len(self.names) - 1} (an int, in fleet order)"
+        raise self._refuse(f"a pose for robot index {index!r}", expected, "")
+
+    def _integer(self, index: int, stamp_ns: Any) -> int:
+        if isinstance(stamp_ns, Integral) and not isinstance(stamp_ns, bool):
+            return int(stamp_ns)
+        what = f"stamp_ns = {stamp_ns!r} ({type(stamp_ns).__name__})"
+        raise self._refuse(what, "an int (kernel ns)", self.names[index])
+
+    def _numbers(self, index: int, *values: Any) -> tuple[float, float, float]:
+        for key, value in zip(("x_m", "y_m", "yaw_rad"), values, strict=True):
+            if not isinstance(value, Real) or isinstance(value, bool):
+                what = f"{key} = {value!r} ({type(value).__name__})"
+                raise self._refuse(what, "a number (m, rad)", self.names[index])
+        x_m, y_m, yaw_rad = (float(v) for v in values)
+        return x_m, y_m, yaw_rad
+
+    def _refuse(self, what: str, expected: str, robot: str) -> PluginError:
+        problem = f"submitted {what}{' for ' + robot if robot else ''}; expected {expected}"
+        doing = f"taking in {robot}'s pose" if robot else "taking in a pose"
+        if self.source is None:
+            return PluginError(None, problem, doing=doing)
+        return refuse(self.source, problem, doing=doing)
 
     def _in_world(self, now_ns: int, index: int, x_m: float, y_m: float) -> bool:
         """Whether the pose lies in the world; leaving it and coming back recorded once."""

@@ -51,13 +51,13 @@ class MocapAdapter:
             )
         fleet = run.service(FleetState)
         self.host = run.add_host(MOCAP_HOST, HostKind.MOCAP)
-        self.intake = PoseIntake(run, self.host)
+        kind = cfg.chosen()
+        self.intake = PoseIntake(run, self.host, source=kind)
         self.records = MocapRecords.of(run)
         index = self.intake.index
         tracked = [
             (index[robot], body) for robot, body in tracked_bodies(run.scenario, fleet.names)
         ]
-        kind = cfg.chosen()
         if kind.external:
             for robot, _ in tracked:
                 self.intake.mirrors.add(robot)

@@ -106,6 +106,15 @@ class LocalController(Protocol):
         """Every robot's speed (m/s) and yaw rate (rad/s), and which found no way ahead.
 
         A robot reported blocked counts as halted: it replans and starts recovering.
+
+        What it returns is checked once per tick (:mod:`adapters.navigation.commands`):
+        three numpy arrays of shape ``(n,)``, speeds and yaw rates of a real dtype and
+        ``blocked`` of ``bool``, else the run ends with a
+        :class:`~cosim.core.plugins.PluginError` naming the controller; so does a NaN or
+        infinite speed or yaw rate. A speed beyond ``robots.max_speed_mps`` (forward) or
+        ``robots.max_reverse_mps`` (backward), or a yaw rate beyond
+        ``robots.max_yaw_rate_radps``, is clipped to the limit and counted
+        (``controller_commands_clipped`` in the summary).
         """
         ...
 

@@ -26,6 +26,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from adapters.navigation.commands import checked_commands
 from adapters.navigation.contract import (
     ControlInputs,
     controller_registry,
@@ -80,6 +81,8 @@ class NavigationAdapter:
         self.cfg = run.settings(NavigationConfig)
         self.parts = build_parts(run)
         self.pose = self.parts.pose
+        self.clipped = 0
+        """Robot commands of the local controller clipped to the drive limits, so far."""
 
     # -- the bus ----------------------------------------------------------------------
     def start(self, run: RunContext) -> None:
@@ -204,7 +207,11 @@ class NavigationAdapter:
         inputs = ControlInputs(
             self.pose, vel, carrots, goals, points, start, moving, discs, disc_start, now_ns
         )
-        v, w, blocked = parts.control.commands(inputs)
+        returned = parts.control.commands(inputs)
+        v, w, blocked, clipped = checked_commands(
+            parts.control, returned, parts.names, parts.limits
+        )
+        self.clipped += clipped
         caps = speed_caps(moving, n, parts.radius_m, parts.limits.max_speed_mps, parts.traffic)
         return np.minimum(v, caps), w, blocked
 
@@ -219,10 +226,11 @@ class NavigationAdapter:
         parts.goals.report(run, remaining)
 
     def finish(self, run: RunContext) -> Mapping[str, Any]:
-        """Arrivals, time to goal, path-length ratio, deadlocks, replans, recoveries."""
+        """Arrivals, time to goal, path-length ratio, deadlocks, replans, recoveries, clips."""
         summary = self.parts.records.summary(run.kernel.now_ns / NS_PER_S)
         active = int(self.parts.goals.active.sum())
         summary["goals_active_at_end"] = active
+        summary["controller_commands_clipped"] = self.clipped
         # accepted goals neither reached nor still being driven to: abandoned after `stuck`
         accepted = summary["goals"] - summary["goals_unreachable"]
         summary["goals_missed"] = accepted - summary["arrivals"] - active

@@ -9,7 +9,11 @@ recorder).
 
 Publishers *advertise* their topics with the message type and QoS, as a ROS 2 node
 creates a publisher; recorders and the live view learn from the advertisements what a
-run will publish before it starts. A *monitor* sees every publication on a topic as it
+run will publish before it starts. A message published on an advertised topic must be
+exactly of the advertised type (one identity comparison per message): another type is
+refused at publication (:class:`~cosim.core.plugins.PluginError`), before any monitor,
+link or subscriber sees it, as it would be recorded under the wrong type and filtered out
+before every inbox. A *monitor* sees every publication on a topic as it
 is published, like a bag recorder on the publishing host: it is neither a subscriber nor
 a host, so it adds no delivery, no network traffic and no row to any table.
 """
@@ -26,6 +30,7 @@ from cosim.core.hosts import HostId
 from cosim.core.kernel import Kernel, Stage
 from cosim.core.link import DELIVERED, AllDelivered, IdealLink, Link, Transfer
 from cosim.core.messages import Message
+from cosim.core.plugins import PluginError
 
 
 class Envelope(NamedTuple):
@@ -116,8 +121,9 @@ class BusTap(Protocol):
         ...
 
 
-Route = tuple[tuple[Callback, ...], tuple[HostId, ...], tuple[Monitor, ...]]
-"""For one topic and publishing host: the local callbacks, the remote hosts, the monitors."""
+Route = tuple[tuple[Callback, ...], tuple[HostId, ...], tuple[Monitor, ...], type[Message] | None]
+"""For one topic and publishing host: the local callbacks, the remote hosts, the monitors,
+and the advertised message type (None: the topic is not advertised)."""
 
 
 class Bus:
@@ -149,10 +155,23 @@ class Bus:
 
         Raises:
             ValueError: if ``topic`` is advertised already with another type or QoS.
+            PluginError: ``message_type`` inherits a declared message without being
+                declared itself (its size and bytes would be its parent's).
         """
+        if hasattr(message_type, "wire") and "wire" not in vars(message_type):
+            parent = next(c for c in message_type.__mro__[1:] if "wire" in vars(c))
+            raise PluginError(
+                None,
+                f"advertised {topic!r} as {_name(message_type)}, a subclass of the declared "
+                f"{_name(parent)} that is not declared itself; expected a message declared "
+                "with cosim.core.messages.ros_message (its size and bytes come from it)",
+                doing=f"advertising {topic!r}",
+            )
         ad = Advertisement(topic, message_type, qos)
         known = self._advertised.setdefault(topic, ad)
-        if known != ad:
+        if known is ad:
+            self._routes.clear()  # publications on it are checked from now on
+        elif known != ad:
             raise ValueError(
                 f"topic {topic!r} is advertised as {known.message_type.__name__} ({known.qos}); "
                 f"cannot advertise it as {message_type.__name__} ({qos})"
@@ -184,7 +203,9 @@ class Bus:
         by_host = self._topics.get(topic, {})
         local = tuple(by_host.get(src, ()))
         remote = tuple(host for host in by_host if host != src)
-        route = (local, remote, tuple(self._monitors.get(topic, ())))
+        ad = self._advertised.get(topic)
+        declared = ad.message_type if ad is not None else None
+        route = (local, remote, tuple(self._monitors.get(topic, ())), declared)
         self._routes[(topic, src)] = route
         return route
 
@@ -193,6 +214,10 @@ class Bus:
 
         Monitors see it first; remote hosts are handed to the link next (their deliveries
         are scheduled), then local subscribers are called at once, in subscription order.
+
+        Raises:
+            PluginError: ``topic`` is advertised with another message type (nothing is
+                published; the plugin is the code that called, named by the runner).
         """
         self.publish_many((topic,), (message,), (src,))
 
@@ -207,6 +232,8 @@ class Bus:
 
         Raises:
             ValueError: when the three sequences differ in length (nothing is published).
+            PluginError: a message is not of its topic's advertised type (the messages
+                before it are published).
         """
         if not len(topics) == len(messages) == len(sources):
             raise ValueError(
@@ -221,7 +248,9 @@ class Bus:
             route = routes.get((topic, src))
             if route is None:
                 route = self._route(topic, src)
-            local, remote, monitors = route
+            local, remote, monitors, declared = route
+            if declared is not None and type(message) is not declared:
+                raise _wrong_type(topic, message, declared)
             for monitor in monitors:
                 monitor(topic, message, src, now)
             if not local and not remote:
@@ -300,3 +329,22 @@ class Bus:
                 raise ValueError(f"link delivered {topic} before it was sent ({delay} ns)")
             arrivals.setdefault(transfer.t_recv_ns, []).append(transfer.dst)
         return arrivals
+
+
+def _wrong_type(topic: str, message: object, declared: type[Message]) -> PluginError:
+    """The error for a message of another type than its topic's advertised one.
+
+    The bus does not know whose code published: the runner names the plugin from the
+    calling frames.
+    """
+    return PluginError(
+        None,
+        f"published a message of type {_name(type(message))} on {topic!r}, advertised as "
+        f"{_name(declared)}; expected {declared.__qualname__} messages only (a topic carries "
+        "the one type it was advertised with)",
+        doing=f"publishing on {topic!r}",
+    )
+
+
+def _name(cls: type) -> str:
+    return f"{cls.__module__}.{cls.__qualname__}"

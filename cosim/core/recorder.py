@@ -106,7 +106,7 @@ class Recorder:
         self._bytes = array("q")
         self._status: list[str] = []
         self._chunks: list[dict[str, npt.NDArray[Any]]] = []
-        self.events = Table(("t_ns", "source", "kind", "detail"))
+        self.events = Table(("t_ns", "source", "kind", "detail"), name="events")
         self.tables: dict[str, Table] = {}
         self.specs: dict[str, TableSpec] = {}
         self.volatile: dict[str, tuple[str, ...]] = {}
@@ -275,7 +275,7 @@ class Recorder:
             )
         if name in self.tables or name in ("messages", "events"):
             raise ValueError(f"table {name!r} exists already")
-        table = Table(columns, categorical)
+        table = Table(columns, categorical, name=name)
         self.tables[name] = table
         for column in volatile:
             if column not in columns:

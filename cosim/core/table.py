@@ -6,6 +6,12 @@ shell turns them into pandas DataFrames and parquet files when the run ends
 (:mod:`cosim.recording.dataframes`), so that the core, and the adapters on it, need no
 pandas. Times are in integer nanoseconds in the kernel and in seconds in the tables'
 ``*_s`` columns.
+
+What is written must match the table's columns: a row or a batch with a column the table
+does not have, without one it has, or with columns of different lengths is refused
+(:class:`~cosim.core.plugins.PluginError` naming the table and the column; the runner names
+the plugin from the calling frames), and nothing of it is kept. The check is one length
+comparison per row, one key comparison per batch.
 """
 
 from __future__ import annotations
@@ -17,6 +23,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from cosim.core.plugins import PluginError
 from cosim.core.timebase import NS_PER_S
 
 
@@ -80,26 +87,51 @@ class Table:
     Args:
         columns: column names in output order.
         categorical: columns holding repeated strings (exported as ``category``).
+        name: the table's name, for errors.
     """
 
-    def __init__(self, columns: Sequence[str], categorical: Iterable[str] = ()) -> None:
+    def __init__(
+        self, columns: Sequence[str], categorical: Iterable[str] = (), *, name: str = ""
+    ) -> None:
         if not columns:
             raise ValueError("a table needs at least one column")
+        self.name = name
         self.names = list(columns)
+        self._keys = frozenset(self.names)
         self.categorical = frozenset(categorical)
         self._rows: dict[str, list[Any]] = {name: [] for name in self.names}
         self._chunks: list[dict[str, npt.NDArray[Any]]] = []
         self._length = 0
 
     def append(self, **row: Any) -> None:
-        """Add one row; every column must be given."""
+        """Add one row; every column must be given, and no other.
+
+        Raises:
+            PluginError: a column missing or unknown (nothing is added).
+        """
+        if len(row) != len(self.names):
+            raise self._mismatch("a row", row.keys())
         rows = self._rows
-        for name in self.names:
-            rows[name].append(row[name])
+        try:
+            for name in self.names:
+                rows[name].append(row[name])
+        except KeyError:  # as many keys, one of them unknown: undo what was appended
+            for name in self.names:
+                if name not in row:
+                    break
+                rows[name].pop()
+            raise self._mismatch("a row", row.keys()) from None
         self._length += 1
 
     def extend(self, **columns: Any) -> None:
-        """Add rows from equal-length arrays; scalars are repeated to that length."""
+        """Add rows from equal-length arrays; scalars are repeated to that length.
+
+        Raises:
+            PluginError: a column missing or unknown, or columns of different lengths
+                (nothing is added).
+        """
+        if columns.keys() != self._keys:
+            raise self._mismatch("rows", columns.keys())
         self._flush_rows()
         arrays = {name: np.asarray(columns[name]) for name in self.names}
         length = max((a.shape[0] for a in arrays.values() if a.ndim), default=1)
@@ -107,9 +139,33 @@ class Table:
             if values.ndim == 0:
                 arrays[name] = np.full(length, values.item())
             elif values.shape[0] != length:
-                raise ValueError(f"column {name!r} has {values.shape[0]} rows, expected {length}")
+                longest = next(n for n, a in arrays.items() if a.ndim and a.shape[0] == length)
+                raise PluginError(
+                    None,
+                    f"wrote rows to table {self.name!r} with {values.shape[0]} values in column "
+                    f"{name!r} and {length} in {longest!r}; expected columns of one length "
+                    "(or a single value, repeated)",
+                    doing=f"recording table {self.name!r}",
+                )
         self._chunks.append(arrays)
         self._length += length
+
+    def _mismatch(self, what: str, given: Iterable[str]) -> PluginError:
+        """The error for ``what`` (a row, rows) written with the columns ``given``."""
+        given = list(given)
+        unknown = [name for name in given if name not in self._keys]
+        missing = [name for name in self.names if name not in given]
+        found = []
+        if unknown:
+            found.append(f"unknown column{'s' * (len(unknown) > 1)} {_listed(unknown)}")
+        if missing:
+            found.append(f"no column {_listed(missing)}")
+        return PluginError(
+            None,
+            f"wrote {what} to table {self.name!r} with {' and '.join(found)}; expected the "
+            f"columns of its TableSpec: {', '.join(self.names)}",
+            doing=f"recording table {self.name!r}",
+        )
 
     def _flush_rows(self) -> None:
         if self._rows[self.names[0]]:
@@ -128,6 +184,10 @@ class Table:
     def columns(self) -> dict[str, npt.NDArray[Any]]:
         """Every column's values, in output order."""
         return {name: self.column(name) for name in self.names}
+
+
+def _listed(names: list[str]) -> str:
+    return ", ".join(repr(name) for name in names)
 
 
 def ns_column(values: npt.ArrayLike) -> npt.NDArray[np.float64]:

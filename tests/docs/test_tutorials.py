@@ -142,6 +142,7 @@ def test_the_controller_tutorials_turn_then_go_drives_robots_to_their_goals(tmp_
     assert done.returncode == 0, done.stderr
     summary = json.loads((out / "summary.json").read_text())
     assert summary["arrivals"] >= 4
+    assert summary["controller_commands_clipped"] == 0  # it keeps to the limits, as the page says
     refused = cosim(env, "check", "warehouse-random", "--set", "turn_then_go.stop_m=0")
     assert refused.returncode == 2 and "expected a number > 0" in refused.stderr
     check_and_test(env, source, "turn_then_go", tests=3)

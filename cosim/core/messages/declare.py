@@ -54,6 +54,9 @@ from cosim.core.messages.wire import Struct
 
 M = TypeVar("M")
 
+DERIVED = ("size_bytes", "to_cdr", "from_cdr")
+"""What a declaration makes of a message class, and the class must not define itself."""
+
 
 class Message:
     """Base of every bus message (declare one with :func:`ros_message`).
@@ -104,10 +107,18 @@ def ros_message(
 
     Raises:
         WireError: a field without a wire type, a binding to no field, a path the type
-            does not have.
+            does not have; a class defining its own size, encoding or decoding (they come
+            from the declaration: a size of one's own could disagree with the bytes).
     """
 
     def declare(cls: type[M]) -> type[M]:
+        for derived in DERIVED:
+            if derived in vars(cls):
+                raise WireError(
+                    f"{cls.__module__}.{cls.__qualname__} defines {derived}(): a declared "
+                    "message's size, encoding and decoding come from its declaration; "
+                    f"expected no {derived} of its own"
+                )
         made: Any = dataclass(frozen=True, slots=True)(cls)
         if isinstance(ros_type, Struct):
             kind, binding = ros_type, view_binding(made, ros_type, wire or {})

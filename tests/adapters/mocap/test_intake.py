@@ -1,13 +1,18 @@
 from pathlib import Path
+from typing import Any, ClassVar
 
+import numpy as np
 import pytest
 
 import cosim
 from adapters.fleet.mirror import Mirrors
+from adapters.mocap.contract import SourceContext
 from adapters.mocap.intake import JUMP_TOLERANCE_RAD, PoseIntake
 from adapters.mocap.topics import pose_topic
 from cosim.core.hosts import HostId
 from cosim.core.messages import PoseStamped
+from cosim.core.plugins import PluginError
+from cosim.core.registry import registered
 from cosim.recording.dataframes import table_frame
 from cosim.runner.assembly import Assembly, assemble
 
@@ -158,3 +163,90 @@ def test_an_accepted_pose_of_a_twin_becomes_its_ground_truth(tmp_path: Path):
     assert mirrors.target[0].tolist() == [2.0, 3.0, 0.25]  # a rejected pose moves nothing
     with pytest.raises(ValueError, match="robot robot_2 is not mirrored"):
         intake.submit(1, 100_000_000, 5.0, 5.0, 0.0, mirror=True)
+
+
+# -- what is not a pose at all: a fault of the source's code ------------------------------------
+class Spoilt:
+    """A plugin pose source (measures nothing) whose ``start`` submits ``pose`` once at 0.1 s."""
+
+    name: ClassVar[str] = "spoilt"
+    external: ClassVar[bool] = False
+    live: ClassVar[bool] = False
+    uses_dds: ClassVar[bool] = False
+    pose: ClassVar[tuple[Any, ...]] = ()
+
+    @classmethod
+    def tracks(cls, mocap: Any, outside: Any, names: list[str]) -> list[tuple[str, str]]:
+        return [(name, "") for name in names]
+
+    @classmethod
+    def describe(cls, mocap: Any, body: str) -> str:
+        return "a test's source"
+
+    def __init__(self, context: SourceContext) -> None:
+        self.intake = context.intake
+
+    def start(self, run: Any) -> None:
+        run.kernel.at(100_000_000, lambda: self.intake.submit(*self.pose, mirror=False))
+
+    def close(self) -> None:
+        pass
+
+    def summary(self) -> dict[str, Any]:
+        return {}
+
+
+def _spoilt(*pose: Any) -> str:
+    source = type("Spoilt", (Spoilt,), {"pose": pose})
+    overrides = {"scenario.duration_s": 0.5, "mocap.source": "spoilt"}
+    with registered("cosim.mocap_sources", "spoilt", source), pytest.raises(PluginError) as caught:
+        cosim.run(scenario(**overrides))
+    error = caught.value
+    assert error.plugin is not None and error.plugin.name == "spoilt"
+    line = str(error)
+    assert line.startswith("motion capture source 'spoilt' (")
+    return line
+
+
+@pytest.mark.parametrize(
+    ("pose", "said"),
+    [
+        (
+            (0, 100_000_000, "1.0", 2.0, 0.0),
+            "submitted x_m = '1.0' (str) for robot_1; expected a number (m, rad) "
+            "while taking in robot_1's pose",
+        ),
+        (
+            (1, 100_000_000, 1.0, None, 0.0),
+            "submitted y_m = None (NoneType) for robot_2; expected a number (m, rad)",
+        ),
+        (
+            (1, 100_000_000, 1.0, 2.0, True),
+            "submitted yaw_rad = True (bool) for robot_2; expected a number (m, rad)",
+        ),
+        (
+            (0, 0.1, 1.0, 2.0, 0.0),
+            "submitted stamp_ns = 0.1 (float) for robot_1; expected an int (kernel ns)",
+        ),
+        (
+            (2, 100_000_000, 1.0, 2.0, 0.0),
+            "submitted a pose for robot index 2; expected a robot index 0 to 1 (an int, in "
+            "fleet order) while taking in a pose",
+        ),
+        (
+            ("robot_1", 100_000_000, 1.0, 2.0, 0.0),
+            "submitted a pose for robot index 'robot_1'; expected a robot index 0 to 1",
+        ),
+    ],
+)
+def test_a_pose_that_is_not_numbers_is_refused_naming_the_source_robot_and_value(pose, said):
+    assert said in _spoilt(*pose)
+
+
+def test_numpy_numbers_are_poses_and_non_finite_ones_stay_measurement_rejections():
+    _, intake, seen = simulated()
+    pose = (np.float32(2.0), 3, np.float64(0.5))
+    assert intake.submit(np.int64(0), np.int64(5), *pose, mirror=False)
+    assert seen[0][1] == PoseStamped(5, "map", 2.0, 3.0, 0.5)
+    assert not intake.submit(0, 6, float("nan"), 3.0, 0.5, mirror=False)  # recorded, not raised
+    assert list(table_frame(intake.records.table).event) == ["invalid"]

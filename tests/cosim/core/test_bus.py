@@ -328,3 +328,114 @@ def test_a_link_delivering_every_copy_at_once_delivers_and_records_as_copy_by_co
 def test_a_link_delivering_before_sending_is_refused_either_way(all_at_once):
     with pytest.raises(ValueError, match="before it was sent"):
         _broadcasts(all_at_once, delay_ns=-1)
+
+
+# -- a topic carries the type it was advertised with -----------------------------------------
+def test_a_message_of_another_type_than_advertised_is_refused_before_anyone_sees_it():
+    from cosim.core.messages import NavGoal
+    from cosim.core.plugins import PluginError
+
+    kernel = Kernel()
+    bus = Bus(kernel, link=FixedDelayLink(5), tap=Recorder())
+    seen: list[str] = []
+    bus.advertise("/cmd", Twist)
+    bus.monitor("/cmd", lambda topic, message, src, t: seen.append("monitor"))
+    bus.subscribe("/cmd", A, lambda message, envelope: seen.append("local"))
+    bus.subscribe("/cmd", B, lambda message, envelope: seen.append("remote"))
+    with pytest.raises(PluginError) as caught:
+        bus.publish("/cmd", NavGoal(0, 1, 2.0, 3.0), A)
+    kernel.run(1_000)
+    assert seen == []
+    assert caught.value.plugin is None  # the runner names it from the calling frames
+    assert str(caught.value) == (
+        "a plugin published a message of type cosim.core.messages.navigation.NavGoal on '/cmd', "
+        "advertised as cosim.core.messages.ros.Twist; expected Twist messages only (a topic "
+        "carries the one type it was advertised with) while publishing on '/cmd'"
+    )
+
+
+def test_publish_many_publishes_the_messages_before_one_of_the_wrong_type_and_none_after():
+    from cosim.core.messages import NavGoal
+    from cosim.core.plugins import PluginError
+
+    kernel = Kernel()
+    bus = Bus(kernel)
+    got: list[tuple[int, Message, Envelope]] = []
+    bus.advertise("/cmd", Twist)
+    bus.subscribe("/cmd", A, _collect(got, kernel))
+    messages: list[Message] = [Twist(1.0, 0.0), NavGoal(0, 1, 2.0, 3.0), Twist(2.0, 0.0)]
+    with pytest.raises(PluginError, match=r"published a message of type .*NavGoal on '/cmd'"):
+        bus.publish_many(["/cmd"] * 3, messages, [A] * 3)
+    assert [m for _, m, _ in got] == [Twist(1.0, 0.0)]
+
+
+def test_a_topic_advertised_after_its_first_publication_is_checked_from_then_on():
+    from cosim.core.messages import NavGoal
+    from cosim.core.plugins import PluginError
+
+    bus = Bus(Kernel())
+    bus.subscribe("/cmd", A, lambda message, envelope: None)
+    bus.publish("/cmd", NavGoal(0, 1, 2.0, 3.0), A)  # not advertised: anything goes
+    bus.advertise("/cmd", Twist)
+    with pytest.raises(PluginError, match=r"advertised as cosim\.core\.messages\.ros\.Twist"):
+        bus.publish("/cmd", NavGoal(0, 2, 2.0, 3.0), A)
+
+
+def test_a_subclass_of_a_declared_message_is_refused_when_advertised():
+    from cosim.core.plugins import PluginError
+
+    class Padded(Twist):  # inherits Twist's declaration: its bytes and size are Twist's
+        def size_bytes(self) -> int:
+            return 1_000
+
+    with pytest.raises(PluginError) as caught:
+        Bus(Kernel()).advertise("/cmd", Padded)
+    assert "advertised '/cmd' as tests.cosim.core.test_bus." in str(caught.value)
+    assert (
+        "Padded, a subclass of the declared cosim.core.messages.ros.Twist that is not declared "
+        "itself; expected a message declared with cosim.core.messages.ros_message"
+    ) in str(caught.value)
+
+
+class OdometryAsGoals:
+    """A plugin adapter sending a NavGoal on robot_1's odometry topic (Odometry) at 0.5 s."""
+
+    name = "odometry_as_goals"
+    requires = ("fleet",)
+
+    def __init__(self, run) -> None:
+        pass
+
+    def start(self, run) -> None:
+        from cosim.core.messages import NavGoal
+
+        goal = NavGoal(0, 1, 2.0, 3.0)
+        run.kernel.at(500_000_000, lambda: run.bus.publish("/robot_1/odom", goal, A))
+
+    def finish(self, run) -> dict[str, float]:
+        return {}
+
+
+def test_a_plugin_publishing_the_wrong_type_in_a_run_is_refused_from_its_own_call():
+    import traceback
+
+    import cosim
+    from cosim.core.plugins import PluginError
+    from cosim.core.registry import registered
+    from tests.conftest import SMALL
+
+    overrides = {**SMALL, "scenario.adapters": [OdometryAsGoals.name]}
+    with (
+        registered("cosim.adapters", OdometryAsGoals.name, OdometryAsGoals),
+        pytest.raises(PluginError) as caught,
+    ):
+        cosim.run(cosim.load_scenario("warehouse-random", overrides))
+    line = str(caught.value)
+    assert "published a message of type cosim.core.messages.navigation.NavGoal on " in line
+    assert "'/robot_1/odom', advertised as cosim.core.messages.ros.Odometry; expected " in line
+    assert "Odometry messages only" in line
+    # the runner names the plugin from the frames the error came through: its own is there,
+    # right above the bus
+    frames = [frame for frame, _ in traceback.walk_tb(caught.value.__traceback__)]
+    assert [f.f_code.co_name for f in frames[-2:]] == ["publish", "publish_many"]
+    assert frames[-3].f_globals["__name__"] == __name__

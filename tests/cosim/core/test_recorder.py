@@ -233,3 +233,46 @@ def test_the_column_lists_are_the_specs_columns_in_order():
     assert EVENT_COLUMNS == ("t_s", "source", "kind", "detail", "t_ns")
     statuses = MESSAGES.columns["status"]
     assert all(status.value in statuses for status in DeliveryStatus)
+
+
+class Scribbler:
+    """A plugin adapter whose table row misspells a column of its TableSpec at 0.5 s."""
+
+    name = "scribbler"
+    requires = ("fleet",)
+    tables = (TableSpec("scribbles", "One row per scribble.", {"t_s": "when", "robot": "who"}),)
+
+    def __init__(self, run) -> None:
+        self.table = run.recorder.table(self.tables[0])
+
+    def start(self, run) -> None:
+        run.kernel.at(500_000_000, lambda: self.table.append(t_s=0.5, robots="robot_1"))
+
+    def finish(self, run) -> dict[str, float]:
+        return {}
+
+
+def test_a_plugins_row_that_does_not_match_its_table_spec_ends_the_run_naming_table_and_column():
+    import traceback
+
+    import cosim
+    from cosim.core.plugins import PluginError
+    from cosim.core.registry import registered
+    from tests.conftest import SMALL
+
+    overrides = {**SMALL, "scenario.adapters": [Scribbler.name]}
+    with (
+        registered("cosim.adapters", Scribbler.name, Scribbler),
+        pytest.raises(PluginError) as caught,
+    ):
+        cosim.run(cosim.load_scenario("warehouse-random", overrides))
+    assert str(caught.value).startswith(
+        "a plugin wrote a row to table 'scribbles' with unknown column 'robots' and no column "
+        "'robot'; expected the columns of its TableSpec: t_s, robot while recording table "
+        "'scribbles'"
+    )
+    # the runner names the plugin from the frames the error came through: its own is there,
+    # right above the table
+    frames = [frame for frame, _ in traceback.walk_tb(caught.value.__traceback__)]
+    assert frames[-1].f_code.co_name == "append"
+    assert frames[-2].f_globals["__name__"] == __name__

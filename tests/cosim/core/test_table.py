@@ -1,11 +1,15 @@
 """Tables kept column-wise while a run goes: rows in append order, strings coded."""
 
 import dataclasses
+import re
 from enum import StrEnum
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
+from cosim.core.plugins import PluginError
 from cosim.core.table import Interner, Table, TableSpec, ns_column
 
 
@@ -26,10 +30,64 @@ def test_rows_appended_come_back_column_by_column_in_order():
     assert len(table) == 2 and table.categorical == frozenset({"robot"})
 
 
-def test_a_row_missing_a_column_is_refused_naming_it():
-    table = Table(("a", "b"))
-    with pytest.raises(KeyError, match="b"):
+def test_a_row_missing_a_column_is_refused_naming_the_table_and_the_column():
+    table = Table(("a", "b"), name="battery")
+    with pytest.raises(PluginError) as caught:
         table.append(a=1)
+    assert str(caught.value) == (
+        "a plugin wrote a row to table 'battery' with no column 'b'; expected the columns of "
+        "its TableSpec: a, b while recording table 'battery'"
+    )
+    assert caught.value.plugin is None  # the runner names it from the calling frames
+    assert len(table) == 0
+
+
+@pytest.mark.parametrize(
+    ("row", "said"),
+    [
+        ({"a": 1, "b": 2, "c": 3}, "with unknown column 'c'; expected"),
+        ({"a": 1, "c": 3}, "with unknown column 'c' and no column 'b'; expected"),
+        ({"c": 3, "d": 4}, "with unknown columns 'c', 'd' and no column 'a', 'b'; expected"),
+    ],
+)
+def test_a_row_with_a_column_the_table_does_not_have_is_refused_and_nothing_kept(row, said):
+    table = Table(("a", "b"), name="battery")
+    table.append(a=0, b=0)
+    with pytest.raises(PluginError, match=re.escape(f"a row to table 'battery' {said}")):
+        table.append(**row)
+    assert {k: v.tolist() for k, v in table.columns().items()} == {"a": [0], "b": [0]}
+    table.append(a=5, b=6)  # the table is whole: the next row lines up
+    assert {k: v.tolist() for k, v in table.columns().items()} == {"a": [0, 5], "b": [0, 6]}
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.dictionaries(st.sampled_from(["a", "b", "c", "t_s"]), st.integers(), max_size=4))
+def test_any_row_is_kept_whole_or_refused_whole(row):
+    table = Table(("t_s", "a", "b"), name="t")
+    try:
+        table.append(**row)
+    except PluginError:
+        assert set(row) != {"t_s", "a", "b"}
+        assert [len(v) for v in table.columns().values()] == [0, 0, 0]
+    else:
+        assert set(row) == {"t_s", "a", "b"}
+        assert [v.tolist() for v in table.columns().values()] == [
+            [row["t_s"]],
+            [row["a"]],
+            [row["b"]],
+        ]
+
+
+def test_a_batch_with_an_unknown_or_missing_column_is_refused_naming_them():
+    table = Table(("t_s", "robot", "charge_wh"), name="battery")
+    with pytest.raises(PluginError) as caught:
+        table.extend(t_s=[0.0, 1.0], robot=["a", "b"], charge=[1.0, 2.0])
+    assert str(caught.value) == (
+        "a plugin wrote rows to table 'battery' with unknown column 'charge' and no column "
+        "'charge_wh'; expected the columns of its TableSpec: t_s, robot, charge_wh while "
+        "recording table 'battery'"
+    )
+    assert len(table) == 0
 
 
 def test_column_batches_and_rows_keep_their_order_and_scalars_repeat():
@@ -49,10 +107,15 @@ def test_a_batch_of_scalars_alone_is_one_row():
     assert table.column("a").tolist() == [1] and table.column("b").tolist() == ["x"]
 
 
-def test_a_batch_with_columns_of_different_lengths_is_refused_naming_the_column():
-    table = Table(("a", "b"))
-    with pytest.raises(ValueError, match=r"column 'b' has 2 rows, expected 3"):
+def test_a_batch_with_columns_of_different_lengths_is_refused_naming_the_columns():
+    table = Table(("a", "b"), name="battery")
+    with pytest.raises(PluginError) as caught:
         table.extend(a=[1, 2, 3], b=[1, 2])
+    assert str(caught.value) == (
+        "a plugin wrote rows to table 'battery' with 2 values in column 'b' and 3 in 'a'; "
+        "expected columns of one length (or a single value, repeated) while recording table "
+        "'battery'"
+    )
     assert len(table) == 0
 
 

@@ -320,3 +320,16 @@ def test_bytes_the_class_refuses_to_hold_are_a_wire_error_naming_the_type():
     data[4:8] = (5).to_bytes(4, "little")
     with pytest.raises(WireError, match=r"labkit_test_msgs/msg/Checked: low 5 above high 2"):
         Checked.from_cdr(bytes(data))
+
+
+@pytest.mark.parametrize("derived", ["size_bytes", "to_cdr", "from_cdr"])
+def test_a_message_defining_its_own_size_or_encoding_is_refused_when_declared(derived):
+    # the declaration would replace it silently; a size of one's own could disagree with
+    # the bytes the bag records and the network model sizes
+    body = {"__annotations__": {"stamp_ns": "uint32"}, derived: lambda self: 0}
+    with pytest.raises(WireError) as refused:
+        ros_message("padded_msgs/msg/Padded")(type("Padded", (Message,), body))
+    assert f"Padded defines {derived}(): a declared message's size, encoding and decoding" in (
+        str(refused.value)
+    )
+    assert str(refused.value).endswith(f"expected no {derived} of its own")
