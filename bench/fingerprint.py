@@ -140,7 +140,8 @@ def run_case(cosim: str, name: str, args: list[str], root: Path) -> dict[str, st
     summary = json.loads((out / "summary.json").read_text())
     volatile = ("wall", "real_time", "version", "started", "compile", "host", "worker", "path")
     kept = {k: v for k, v in summary.items() if not any(w in k for w in volatile)}
-    found["summary"] = hashlib.sha256(json.dumps(kept, sort_keys=True).encode()).hexdigest()[:16]
+    for key, value in sorted(kept.items()):  # by key, so a difference names its entry
+        found[f"summary/{key}"] = hashlib.sha256(json.dumps(value).encode()).hexdigest()[:16]
     return found
 
 

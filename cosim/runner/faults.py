@@ -85,8 +85,18 @@ def fault_of(
         A :class:`PluginError` when a plugin's frame is in the traceback (or the error is
         one already, raised at the boundary); an :class:`InternalError` for any other
         exception; any other :class:`CosimError` as it is (bad input met mid-run, an
-        external system gone), its traceback kept.
+        external system gone), its traceback kept. A new error's ``__cause__`` is
+        ``error``, whose traceback still holds the frames it came through.
     """
+    fault = _fault_of(error, doing=doing, t_ns=t_ns)
+    if fault is not error:  # the exception that escaped stays reachable, with its frames
+        fault.__cause__ = error
+    return fault
+
+
+def _fault_of(
+    error: BaseException, *, doing: str, t_ns: int | None
+) -> PluginError | InternalError | CosimError:
     details = "".join(traceback.format_exception(error))
     plugin, where = blame(error.__traceback__)
     if isinstance(error, PluginError):

@@ -436,6 +436,6 @@ def test_a_plugin_publishing_the_wrong_type_in_a_run_is_refused_from_its_own_cal
     assert "Odometry messages only" in line
     # the runner names the plugin from the frames the error came through: its own is there,
     # right above the bus
-    frames = [frame for frame, _ in traceback.walk_tb(caught.value.__traceback__)]
+    frames = [frame for frame, _ in traceback.walk_tb(caught.value.__cause__.__traceback__)]
     assert [f.f_code.co_name for f in frames[-2:]] == ["publish", "publish_many"]
     assert frames[-3].f_globals["__name__"] == __name__

@@ -267,12 +267,12 @@ def test_a_plugins_row_that_does_not_match_its_table_spec_ends_the_run_naming_ta
     ):
         cosim.run(cosim.load_scenario("warehouse-random", overrides))
     assert str(caught.value).startswith(
-        "a plugin wrote a row to table 'scribbles' with unknown column 'robots' and no column "
+        f"adapter 'scribbler' ({__name__}:Scribbler, given in code) wrote a row to table 'scribbles' with unknown column 'robots' and no column "
         "'robot'; expected the columns of its TableSpec: t_s, robot while recording table "
-        "'scribbles'"
+        "'scribbles' at t = 0.5 s simulated"
     )
     # the runner names the plugin from the frames the error came through: its own is there,
     # right above the table
-    frames = [frame for frame, _ in traceback.walk_tb(caught.value.__traceback__)]
+    frames = [frame for frame, _ in traceback.walk_tb(caught.value.__cause__.__traceback__)]
     assert frames[-1].f_code.co_name == "append"
     assert frames[-2].f_globals["__name__"] == __name__

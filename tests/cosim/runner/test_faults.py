@@ -155,6 +155,7 @@ def test_a_bug_of_cosim_mid_run_is_an_internal_error_keeping_what_ran(monkeypatc
 
 def test_a_builtin_refused_at_the_boundary_is_cosims_bug_not_a_plugins():
     import adapters.navigation.contract  # noqa: F401 - declares the group's words
+
     builtin = PluginInfo("cosim", "0.1.0", "cosim.controllers", "dwa", "x:Dwa")
     refused = PluginError(builtin, "returned nan")
     fault = fault_of(refused, doing="computing commands", t_ns=3)
