@@ -10,7 +10,8 @@ three things to a plain :class:`simpy.Environment`:
   priorities (0 and 1) and so run before every stage at the same instant.
 * **Periodic callbacks** that reschedule themselves without a generator frame, so that
   thousands of exact-rate tasks stay cheap.
-* **A counting run loop** that reports progress and the number of processed events.
+* **A counting run loop** that reports progress and the number of processed events, and
+  lets the exception a failed process raised out as it was raised (:func:`escaped`).
 """
 
 from __future__ import annotations
@@ -29,6 +30,33 @@ from simpy.events import EventPriority
 HEARTBEAT_EVENTS = 256
 """Events between two heartbeats (and looks at the wall clock for progress) of a run."""
 _HEARTBEAT_MASK = HEARTBEAT_EVENTS - 1
+
+
+def escaped(error: BaseException) -> BaseException:
+    """The exception a failed process raised, where SimPy raised a copy of it (or failed to).
+
+    SimPy crashes a run on a failed process by raising ``type(e)(*e.args)``, a copy with a
+    new traceback through its own ``step``; a class whose constructor does not take its
+    ``args`` back (``MyError(code, text)``) fails there with an error of its own. Either
+    way, this returns the exception the process's code raised, with the frames it came
+    through; any other exception as it is.
+    """
+    cause = error.__cause__
+    if cause is not None and type(cause) is type(error) and cause.args == error.args:
+        return cause
+    trace = error.__traceback__
+    while trace is not None:  # the copy's constructor failed: the event is in step's frame
+        if trace.tb_frame.f_code is _STEP:
+            event = trace.tb_frame.f_locals.get("event")
+            value = getattr(event, "_value", None)
+            if isinstance(value, BaseException) and not event._ok and value is not error:  # type: ignore[union-attr]
+                return value
+            break
+        trace = trace.tb_next
+    return error
+
+
+_STEP = simpy.Environment.step.__code__
 
 
 class Stage(IntEnum):
@@ -257,6 +285,11 @@ class Kernel:
                     if progress is not None and wall >= next_report:
                         progress(self.now_ns, processed)
                         next_report = wall + progress_interval_s
+        except BaseException as error:
+            original = escaped(error)
+            if original is error:
+                raise
+            raise original from original.__cause__
         finally:  # a failed event or a stop: the events that completed still count
             self.events_processed += processed
         if until_ns > self.now_ns:
@@ -302,6 +335,11 @@ class Kernel:
                 if progress is not None and monotonic() >= next_report:
                     progress(self.now_ns, processed)
                     next_report = monotonic() + progress_interval_s
+        except BaseException as error:
+            original = escaped(error)
+            if original is error:
+                raise
+            raise original from original.__cause__
         finally:  # a stop (Ctrl-C, an error) may land anywhere: keep the columns aligned
             record.close_batch(batch_events)
             self.events_processed += processed

@@ -68,7 +68,10 @@ class Hung(BaseException):
 
     def __init__(self, timeout_s: float) -> None:
         self.timeout_s = timeout_s
-        super().__init__(f"did not return within {timeout_s:g} s")
+        super().__init__(timeout_s)  # args that build it again, as SimPy does
+
+    def __str__(self) -> str:
+        return f"did not return within {self.timeout_s:g} s"
 
 
 def fault_of(

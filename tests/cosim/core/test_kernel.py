@@ -1,3 +1,5 @@
+import traceback
+
 import pytest
 import simpy
 
@@ -76,6 +78,40 @@ def test_a_failing_process_is_reraised_by_the_run():
     kernel.process(broken())
     with pytest.raises(RuntimeError, match="sensor exploded"):
         kernel.run(10)
+
+
+def test_the_run_raises_the_very_exception_a_process_raised_with_its_frames():
+    kernel = Kernel()
+    raised = RuntimeError("sensor exploded")
+
+    def broken():
+        yield kernel.timeout(5)
+        raise raised
+
+    kernel.process(broken())
+    with pytest.raises(RuntimeError) as caught:
+        kernel.run(10)
+    assert caught.value is raised  # not SimPy's copy
+    assert "broken" in [f.name for f in traceback.extract_tb(caught.value.__traceback__)]
+
+
+class TwoArgsError(Exception):
+    def __init__(self, code, text):
+        super().__init__(f"{code}: {text}")
+
+
+@pytest.mark.parametrize("realtime", [False, True])
+def test_an_exception_simpy_cannot_copy_still_leaves_the_run_as_raised(realtime):
+    kernel = Kernel(realtime=realtime, speed=1000.0) if realtime else Kernel()
+
+    def broken():
+        yield kernel.timeout(5)
+        raise TwoArgsError(7, "unplugged")
+
+    kernel.process(broken())
+    with pytest.raises(TwoArgsError, match="7: unplugged"):
+        kernel.run(10)
+    assert kernel.events_processed >= 1
 
 
 def test_staged_timeout_rejects_a_negative_delay():

@@ -27,6 +27,13 @@ SMALL = {
 }
 
 
+class DeviceError(Exception):
+    """An exception whose constructor does not take its ``args`` back (SimPy cannot copy it)."""
+
+    def __init__(self, code, text):
+        super().__init__(f"device error {code}: {text}")
+
+
 class Faulty:
     """An adapter that fails where the test tells it to."""
 
@@ -43,6 +50,21 @@ class Faulty:
         if self.where == "start":
             _ = {}["missing"]
         run.kernel.every(100_000_000, self.tick, stage=Stage.CONTROL)
+        if self.where.startswith("process"):
+            run.kernel.process(self.poll(run.kernel))
+
+    def poll(self, kernel):
+        """A SimPy process: a generator the kernel resumes every 0.5 s."""
+        while True:
+            yield kernel.timeout(500_000_000)
+            if kernel.now_ns < 1_500_000_000:
+                continue
+            if self.where == "process":
+                raise KeyError("no such channel")
+            if self.where == "process_odd":
+                raise DeviceError(7, "unplugged")
+            while self.where == "process_hang":
+                pass
 
     def tick(self, now_ns):
         self.ticks += 1
@@ -139,6 +161,27 @@ def test_a_plugin_that_hangs_is_stopped_and_named_where_it_hangs(faulty):
     error = _raised(faulty("hang", **{"scenario.hang_timeout_s": 0.5}))
     assert "did not return within 0.5 s (scenario.hang_timeout_s) in Faulty.tick" in str(error)
     assert error.kept.summary["sim_time_s"] == 1.0
+
+
+@pytest.mark.parametrize(
+    ("where", "said"),
+    [
+        ("process", "raised KeyError: 'no such channel' in Faulty.poll"),
+        ("process_odd", "raised DeviceError: device error 7: unplugged in Faulty.poll"),
+    ],
+)
+def test_a_plugins_process_raising_is_named_with_its_own_frame(faulty, where, said):
+    # SimPy raises a copy of a failed process's exception, built again from its args (or
+    # failing to be); the run sees the one the plugin raised
+    error = _raised(faulty(where))
+    assert said in str(error), str(error)
+    assert "at t = 1.5 s simulated" in str(error)
+    assert error.kept.summary["sim_time_s"] == 1.5
+
+
+def test_a_plugins_process_that_hangs_is_stopped_and_named(faulty):
+    error = _raised(faulty("process_hang", **{"scenario.hang_timeout_s": 0.5}))
+    assert "did not return within 0.5 s (scenario.hang_timeout_s) in Faulty.poll" in str(error)
 
 
 def test_a_bug_of_cosim_mid_run_is_an_internal_error_keeping_what_ran(monkeypatch):
