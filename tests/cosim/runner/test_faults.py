@@ -3,6 +3,7 @@
 import json
 import operator
 import sys
+import traceback
 
 import pytest
 
@@ -108,6 +109,10 @@ def test_a_plugin_raising_mid_run_is_named_with_its_code_and_the_simulated_time(
         "at 2000000000 ns in Faulty.tick (runner/test_faults.py:"
     )
     assert str(error).endswith("while running the simulation at t = 2 s simulated")
+    # the exception the plugin raised, with its own frames, for a debugger or a notebook
+    assert isinstance(error.__cause__, ValueError)
+    assert traceback.extract_tb(error.__cause__.__traceback__)[-1].name == "tick"
+    assert "ValueError: bad reading at 2000000000 ns" in error.details
     assert "Traceback" in error.details and "raise ValueError" in error.details
 
 
