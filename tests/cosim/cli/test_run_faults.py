@@ -208,7 +208,7 @@ def test_a_signal_mid_run_keeps_the_bag_the_tables_and_a_summary_that_says_so(si
     reached = summary["sim_time_s"]
     assert 0 < reached < 1e6
     poses = pd.read_parquet(out / "tables" / "poses.parquet")
-    assert reached - 0.1 <= poses.t_s.max() <= reached
+    assert reached - 0.1 - 1e-9 <= poses.t_s.max() <= reached  # 4.2 - 0.1 > 4.1 in floats
     assert len(pd.read_parquet(out / "tables" / f"{MESSAGES.name}.parquet")) > 0
 
 

@@ -267,7 +267,8 @@ def test_a_plugins_row_that_does_not_match_its_table_spec_ends_the_run_naming_ta
     ):
         cosim.run(cosim.load_scenario("warehouse-random", overrides))
     assert str(caught.value).startswith(
-        f"adapter 'scribbler' ({__name__}:Scribbler, given in code) wrote a row to table 'scribbles' with unknown column 'robots' and no column "
+        f"adapter 'scribbler' ({__name__}:Scribbler, given in code) wrote a row to table "
+        "'scribbles' with unknown column 'robots' and no column "
         "'robot'; expected the columns of its TableSpec: t_s, robot while recording table "
         "'scribbles' at t = 0.5 s simulated"
     )

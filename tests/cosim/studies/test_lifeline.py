@@ -133,7 +133,7 @@ def test_a_study_stopped_by_a_signal_exits_with_128_plus_its_number():
 def test_sigterm_inside_stop_on_signals_raises_study_stopped_and_the_handler_comes_back():
     before = signal.getsignal(signal.SIGTERM)
     with pytest.raises(StudyStopped) as stopped, stop_on_signals():
-        os.kill(os.getpid(), signal.SIGTERM)
+        signal.raise_signal(signal.SIGTERM)
         time.sleep(1)  # the handler runs at the next bytecode
     assert stopped.value.signum == signal.SIGTERM
     assert signal.getsignal(signal.SIGTERM) is before
