@@ -42,6 +42,7 @@ ASSIGNMENTS = TableSpec(
         "bytes": "bytes of those messages",
     },
     categorical=("robot",),
+    units={"epoch": "id", "round": "count", "cost": "m", "messages": "count", "bytes": "bytes"},
 )
 ASSIGNMENT_COLUMNS = tuple(ASSIGNMENTS.columns)
 

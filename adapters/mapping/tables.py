@@ -76,6 +76,12 @@ MAP_QUALITY = TableSpec(
         "iou_strict": "iou without the cell of tolerance",
     },
     categorical=("robot",),
+    units={
+        "coverage": "fraction",
+        "iou": "fraction",
+        "accuracy": "fraction",
+        "iou_strict": "fraction",
+    },
 )
 QUALITY_COLUMNS = tuple(MAP_QUALITY.columns)
 SCAN_MATCHES = TableSpec(
@@ -93,6 +99,7 @@ SCAN_MATCHES = TableSpec(
         "matched": "whether the match was accepted (else odometry was kept)",
     },
     categorical=("robot",),
+    units={"score": "fraction"},
 )
 MATCH_COLUMNS = tuple(SCAN_MATCHES.columns)
 MAP_MERGES = TableSpec(
@@ -108,6 +115,7 @@ MAP_MERGES = TableSpec(
         "cells": "cells of the robot's map it changed",
     },
     categorical=("robot", "source", "kind"),
+    units={"bytes": "bytes", "cells": "count"},
 )
 MERGE_COLUMNS = tuple(MAP_MERGES.columns)
 FLEET = "fleet"

@@ -73,6 +73,7 @@ TASKS_TABLE = TableSpec(
         "reassignments": "how often its claim passed from one robot to another",
     },
     categorical=("robot",),
+    units={"task": "id", "reassignments": "count"},
 )
 TASK_COLUMNS = tuple(TASKS_TABLE.columns)
 ANNOUNCE_HZ = 5.0

@@ -106,17 +106,17 @@ class UnitySink:
         "unity_frames_dropped": SummaryKey(
             "count",
             "frames a connection too slow to take them missed",
-            when="some were",
+            when="a frame was dropped",
         ),
         "unity_twists": SummaryKey(
             "count",
             "velocity commands taken from the scenes",
-            when="the run takes them (teleop driver)",
+            when="robots.driver = 'teleop'",
         ),
         "unity_poses": SummaryKey(
             "count",
             "tracked poses taken from the scenes",
-            when="the run takes them (mocap.source = unity)",
+            when="mocap.source = 'unity'",
         ),
     }
 

@@ -64,7 +64,7 @@ RUN_KEYS: Mapping[str, SummaryKey] = {
     ),
     "messages_delivered": SummaryKey("count", "of messages_sent, those delivered"),
     "messages_dropped": SummaryKey(
-        "count", "of messages_sent, those lost, queued out, out of range or partitioned"
+        "count", "of messages_sent, those dropped: lost, queue full, out of range or partitioned"
     ),
     "network_messages": SummaryKey(
         "count", "of messages_sent, those between two different hosts (over the network)"
