@@ -43,8 +43,7 @@ def test_a_declaration_that_is_no_mapping_of_summary_keys_is_named():
 
     assert summary_keys_of(Listed) == {}
     assert declaration_problems(Listed) == [
-        "summary_keys is a tuple; expected a mapping of key names to "
-        "cosim.core.summary.SummaryKey"
+        "summary_keys is a tuple; expected a mapping of key names to cosim.core.summary.SummaryKey"
     ]
     assert list(summary_keys_of(Loose)) == ["", "battery_ok"]
     assert declaration_problems(Loose) == [
