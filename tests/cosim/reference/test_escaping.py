@@ -4,7 +4,12 @@ from __future__ import annotations
 
 import pytest
 
+from cosim.reference.commands_page import commands_markdown
 from cosim.reference.escaping import cell, code, fenced, text
+from cosim.reference.keys_page import keys_markdown
+from cosim.reference.registries_page import registries_markdown
+from cosim.reference.summary_page import summary_markdown
+from cosim.reference.tables_page import tables_markdown
 from tests.cosim.reference.rendered import cells, render, shown, tags
 
 QUOTED = [
@@ -87,3 +92,17 @@ def test_text_leaves_plain_prose_alone():
     said = "every key (m/s), one of 'a', 'b'; >= 0 and <= 1: map_quality rows"
     assert text(said) == said
     assert cell(said) == said
+
+
+MARKUP = {"h1", "h2", "h3", "p", "em", "code", "a", "ul", "li", "pre", "div", "span"}
+TABLES = {"table", "thead", "tbody", "tr", "th", "td"}
+
+
+@pytest.mark.parametrize(
+    "page",
+    [keys_markdown, tables_markdown, summary_markdown, commands_markdown, registries_markdown],
+)
+def test_no_generated_page_holds_a_tag_of_what_it_quotes(page):
+    # a quoted <robot>, <subject> or <b> would be a tag of its own; *x* would be em only
+    # where the generator marks something (category, volatile, registered by)
+    assert tags(page()) <= MARKUP | TABLES
