@@ -269,6 +269,8 @@ UNITS = {
     "_mbps": "Mbit/s",
     "_dbm": "dBm",
     "_db": "dB",
+    "_wh": "Wh",
+    "_w": "W",
     "_hz": "Hz",
     "_ms": "ms",
     "_ns": "ns",
@@ -282,7 +284,15 @@ UNITS = {
 
 
 def unit_of(key: str) -> str:
-    """The unit a key's name carries, or an empty string."""
+    """The unit a key's name carries, or an empty string.
+
+    ``X_per_<unit>`` carries X's unit per that unit: ``drive_wh_per_m`` is in Wh/m,
+    ``cost_per_m`` in 1/m.
+    """
+    for suffix, unit in UNITS.items():
+        per = "_per" + suffix
+        if key.endswith(per) and len(key) > len(per):
+            return f"{unit_of('_' + key[: -len(per)]) or '1'}/{unit}"
     return next((unit for suffix, unit in UNITS.items() if key.endswith(suffix)), "")
 
 

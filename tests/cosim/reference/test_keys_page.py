@@ -180,6 +180,11 @@ def test_decibels_inverse_metres_probabilities_and_counts_have_their_unit_shown(
         ("tx_power_dbm", "dBm"),
         ("shadowing_db", "dB"),
         ("t_sent_ns", "ns"),
+        ("capacity_wh", "Wh"),
+        ("idle_w", "W"),
+        ("drive_wh_per_m", "Wh/m"),  # not m: what comes before _per_ counts
+        ("cost_per_m", "1/m"),
+        ("rad_per_m", "rad/m"),
         ("count", ""),
         ("ge_p", ""),
     ],
