@@ -51,7 +51,7 @@ class RangeFinderSettings:
 
     rate_hz: float = param(10.0, "readings per second (Hz)", gt=0, le=1000)
     fov_deg: float = param(15.0, "width of the sensing cone (deg)", gt=0, le=90)
-    rays: int = param(5, "rays cast across the cone", ge=1, le=100)
+    rays: int = param(5, "rays cast across the cone", ge=1, le=100, unit="count")
     range_min_m: float = param(0.02, "nearest reading (m)", ge=0)
     range_max_m: float = param(4.0, "farthest reading (m)", gt=0, le=100)
 
