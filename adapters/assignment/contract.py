@@ -161,7 +161,12 @@ class AssignmentProtocolType(Protocol):
         ...
 
     def summary(self) -> Mapping[str, Any]:
-        """Extra summary metrics of the run (flat, JSON-serializable)."""
+        """Extra summary metrics of the run (flat, JSON-serializable).
+
+        Each key is declared, with its unit and meaning, in the class's ``summary_keys``
+        (a mapping of key to :class:`cosim.core.summary.SummaryKey`), which the summary
+        reference shows.
+        """
         ...
 
 

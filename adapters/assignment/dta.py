@@ -31,7 +31,7 @@ from adapters.assignment.contract import (
     protocol_registry,
 )
 from adapters.assignment.settings import AssignmentConfig
-from adapters.assignment.tables import ASSIGNMENTS, DtaRecords
+from adapters.assignment.tables import ASSIGNMENTS, DTA_SUMMARY, DtaRecords
 from adapters.assignment.topics import ASSIGNMENT
 from adapters.fleet.topics import odom_topic
 from adapters.navigation.topics import goal_topic, status_topic
@@ -67,6 +67,7 @@ from cosim.core.messages import (
     TaskOrder,
     TaskSet,
 )
+from cosim.core.summary import SummaryKey
 from cosim.core.table import TableSpec
 from cosim.core.timebase import period_ns, s_to_ns
 from models.assignment.problem import AssignmentProblem
@@ -84,6 +85,9 @@ class DtaAdapter:
     requires: ClassVar[tuple[str, ...]] = ("fleet", "network", "navigation", "task_source")
     tables: ClassVar[tuple[TableSpec, ...]] = (ASSIGNMENTS,)
     """The tables it writes (documented in the table reference)."""
+    summary_keys: ClassVar[Mapping[str, SummaryKey]] = DTA_SUMMARY
+    """The summary keys :meth:`finish` writes; the protocol's own ``summary()`` keys are
+    declared by the protocol class (documented in the summary reference)."""
 
     def __init__(self, run: RunContext) -> None:
         self.cfg = run.settings(AssignmentConfig)

@@ -21,6 +21,7 @@ import numpy as np
 from adapters.assignment.contract import EpochView, ProtocolAgent, ProtocolBase, ProtocolFleet
 from adapters.assignment.topics import BASES, BIDS
 from cosim.core.messages import CbbaBids, Message, SimplexBasis, TaskInfo
+from cosim.core.summary import SummaryKey
 from models.assignment.cbba import CbbaAgent, scores_from_cost
 from models.assignment.dsimplex import SharedBasis, agent_for
 from models.assignment.greedy import nearest_free
@@ -266,6 +267,11 @@ class Hungarian(ProtocolBase):
 
     name: ClassVar[str] = "hungarian"
     central: ClassVar[bool] = True
+    summary_keys: ClassVar[Mapping[str, SummaryKey]] = {
+        "optimality_gap": SummaryKey(
+            "ratio", "0: the base station solves each instance to its optimum"
+        ),
+    }
 
     def agent(self, epoch: EpochView) -> ProtocolAgent | None:
         """None: orders come from the base station."""

@@ -34,7 +34,10 @@ class AssignmentConfig:
         False, "a robot heading to its task may be re-assigned by a later epoch"
     )
     diameter_bound: int = param(
-        0, "bound on the robot graph's diameter for halting; 0 = from the topology", ge=0
+        0,
+        "bound on the robot graph's diameter for halting; 0 = from the topology",
+        ge=0,
+        unit="hops",
     )
     cost: Literal["euclidean", "path"] = param(
         "euclidean", "task cost: straight-line distance, or shortest path on the static map"

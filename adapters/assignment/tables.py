@@ -14,6 +14,7 @@ greedy (its conflicts are its measure).
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -21,6 +22,7 @@ import numpy as np
 
 from adapters.assignment.contract import ProtocolAgent
 from cosim.core.recorder import Recorder
+from cosim.core.summary import SummaryKey
 from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S
 from models.assignment.problem import AssignmentProblem, hungarian, objective
@@ -40,6 +42,7 @@ ASSIGNMENTS = TableSpec(
         "bytes": "bytes of those messages",
     },
     categorical=("robot",),
+    units={"epoch": "id", "round": "count", "cost": "m", "messages": "count", "bytes": "bytes"},
 )
 ASSIGNMENT_COLUMNS = tuple(ASSIGNMENTS.columns)
 
@@ -56,6 +59,34 @@ class _Epoch:
     nbytes: dict[int, int] = field(default_factory=dict)
     closed: bool = False
     takers: frozenset[int] | None = None  # robots with a finite cost, once every row is in
+
+
+DTA_SUMMARY: Mapping[str, SummaryKey] = {
+    "mean_convergence_time_s": SummaryKey(
+        "s",
+        "time from an epoch's announcement until every robot that could take a task had "
+        "decided, mean over decided epochs (null: none)",
+    ),
+    "mean_rounds": SummaryKey(
+        "count", "protocol rounds a robot took to decide an epoch, mean (null: none decided)"
+    ),
+    "optimality_gap": SummaryKey(
+        "ratio",
+        "excess of the robots' assignment cost over the central optimum of the same "
+        "instance (0.1: 10 % costlier), mean over compared epochs (null: none compared)",
+    ),
+    "epochs_compared": SummaryKey("count", "epochs whose decisions were compared with the optimum"),
+    "epochs_incomplete": SummaryKey(
+        "count",
+        "epochs where robots halted on partial information and left tasks the optimum "
+        "serves (left out of the gap)",
+    ),
+    "conflicts_seen_by_robots": SummaryKey(
+        "count", "times a robot saw another robot's better claim on its task and gave way"
+    ),
+    "claims_released": SummaryKey("count", "times a robot gave its task up"),
+}
+"""The summary keys :meth:`DtaRecords.summary` writes."""
 
 
 class DtaRecords:

@@ -24,6 +24,7 @@ from cosim.core.bus import Envelope
 from cosim.core.hosts import HostId
 from cosim.core.kernel import Stage
 from cosim.core.messages import Message, Twist
+from cosim.core.summary import SummaryKey
 from cosim.core.timebase import period_ns, s_to_ns
 from cosim.scenario.sections import RobotsConfig
 from models.fleet.kinematics import FleetState
@@ -37,6 +38,13 @@ class TeleopAdapter:
 
     name: ClassVar[str] = "teleop"
     requires: ClassVar[tuple[str, ...]] = ("fleet",)
+    summary_keys: ClassVar[Mapping[str, SummaryKey]] = {
+        "teleop_commands": SummaryKey("count", "operator velocity commands taken"),
+        "teleop_deadman_stops": SummaryKey(
+            "count", f"robots stopped after {DEADMAN_S:g} s without a command"
+        ),
+    }
+    """The summary keys :meth:`finish` writes (documented in the summary reference)."""
 
     def __init__(self, run: RunContext) -> None:
         robots = run.settings(RobotsConfig)

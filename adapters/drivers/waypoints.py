@@ -25,6 +25,7 @@ from cosim.core.bus import Envelope
 from cosim.core.hosts import HostId
 from cosim.core.kernel import Stage
 from cosim.core.messages import Goal, Message, Odometry, Twist
+from cosim.core.summary import SummaryKey
 from cosim.core.timebase import period_ns, s_to_ns
 from cosim.scenario.sections import RobotsConfig
 from models.drivers.goto import GoToGains, go_to_goal
@@ -45,6 +46,13 @@ class WaypointsAdapter:
 
     name: ClassVar[str] = "waypoints"
     requires: ClassVar[tuple[str, ...]] = ("world", "fleet")
+    summary_keys: ClassVar[Mapping[str, SummaryKey]] = {
+        "waypoints_reached": SummaryKey("count", "random waypoints the robots reached"),
+        "waypoints_abandoned": SummaryKey(
+            "count", "waypoints given up (not reached in time, or the robot stalled)"
+        ),
+    }
+    """The summary keys :meth:`finish` writes (documented in the summary reference)."""
 
     def __init__(self, run: RunContext) -> None:
         self.world = run.service(Warehouse)

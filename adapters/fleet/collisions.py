@@ -20,6 +20,7 @@ import numpy as np
 
 from adapters.fleet.motion import FleetAdapter
 from cosim.core.adapter import RunContext
+from cosim.core.summary import SummaryKey
 from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S
 from models.fleet.collision import CollisionChecker, OtherKind, Proximity
@@ -55,6 +56,18 @@ class CollisionsAdapter:
     requires: ClassVar[tuple[str, ...]] = ("world", "fleet")
     tables: ClassVar[tuple[TableSpec, ...]] = (COLLISIONS,)
     """The tables it writes (documented in the table reference)."""
+    summary_keys: ClassVar[Mapping[str, SummaryKey]] = {
+        "collisions": SummaryKey(
+            "count", "contacts of a robot with anything (rows of tables/collisions)"
+        ),
+        "near_misses": SummaryKey(
+            "count", f"times a robot came closer than {NEAR_MISS_M:g} m to anything"
+        ),
+        "min_clearance_m": SummaryKey(
+            "m", "smallest clearance between a robot and anything (null: never checked)"
+        ),
+    }
+    """The summary keys :meth:`finish` writes (documented in the summary reference)."""
 
     def __init__(self, run: RunContext) -> None:
         world = run.service(Warehouse)

@@ -25,6 +25,7 @@ from cosim.core.hosts import HostKind
 from cosim.core.kernel import Stage
 from cosim.core.messages import Message, Odometry, Twist
 from cosim.core.rng import BlockDraws
+from cosim.core.summary import SummaryKey
 from cosim.core.timebase import NS_PER_S, period_ns
 from cosim.scenario.sections import OdometryConfig, RobotsConfig
 from models.fleet.kinematics import DriveLimits, FleetState, Motion
@@ -52,6 +53,14 @@ class FleetAdapter:
 
     name: ClassVar[str] = "fleet"
     requires: ClassVar[tuple[str, ...]] = ("world",)
+    summary_keys: ClassVar[Mapping[str, SummaryKey]] = {
+        "robots": SummaryKey("count", "robots in the fleet"),
+        "distance_m": SummaryKey("m", "distance driven by all robots together"),
+        "odometry_error_m_mean": SummaryKey(
+            "m", "distance between a robot's odometry position and its true one at the end, mean"
+        ),
+    }
+    """The summary keys :meth:`finish` writes (documented in the summary reference)."""
 
     def __init__(self, run: RunContext) -> None:
         world = run.service(Warehouse)

@@ -51,9 +51,10 @@ from adapters.humans.files import (
 )
 from adapters.humans.session import Movers, SumoSession
 from adapters.humans.settings import HumansConfig
-from adapters.humans.tables import HUMANS, HumanRecords
+from adapters.humans.tables import HUMANS, HUMANS_SUMMARY, HumanRecords
 from cosim.core.adapter import RunContext
 from cosim.core.kernel import Stage
+from cosim.core.summary import SummaryKey
 from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns
 from cosim.scenario.fields import model_problem
@@ -81,6 +82,33 @@ class HumansAdapter:
     requires: ClassVar[tuple[str, ...]] = ("world", "fleet")
     tables: ClassVar[tuple[TableSpec, ...]] = (HUMANS,)
     """The tables it writes (documented in the table reference)."""
+    summary_keys: ClassVar[Mapping[str, SummaryKey]] = {
+        **HUMANS_SUMMARY,
+        "humans_workers": SummaryKey("count", "walking workers (humans.workers)"),
+        "humans_standing": SummaryKey("count", "standing workers (humans.standing)"),
+        "humans_forklifts": SummaryKey("count", "forklifts (humans.forklifts)"),
+        "humans_sumo_steps": SummaryKey("count", "SUMO steps taken"),
+        "humans_pushed_out": SummaryKey(
+            "count", "person samples SUMO put reaching into a shelf or wall, moved out"
+        ),
+        "humans_yields": SummaryKey("count", "times a walker stopped to let a robot pass"),
+        "humans_steps_cut": SummaryKey(
+            "count", "walker steps cut short of a robot (SUMO's step would have touched it)"
+        ),
+        "humans_forklift_yields": SummaryKey(
+            "count", "times a forklift stopped to let a robot pass"
+        ),
+        "humans_trips": SummaryKey("count", "walks SUMO completed"),
+        "humans_coupling_wall_s": SummaryKey(
+            "s", "wall-clock time spent stepping SUMO and exchanging positions", volatile=True
+        ),
+        "humans_sumo_in_process": SummaryKey(
+            "true/false",
+            "SUMO ran inside the process (libsumo) rather than as a TraCI server",
+            volatile=True,
+        ),
+    }
+    """The summary keys :meth:`finish` writes (documented in the summary reference)."""
 
     def __init__(self, run: RunContext) -> None:
         cfg = run.settings(HumansConfig)

@@ -23,12 +23,17 @@ class HumansConfig:
     ORDER: ClassVar[int] = 120
     """Where the section comes in a resolved scenario and in the adapters' order."""
 
-    workers: int = param(0, "workers walking between pick stations and the dock", ge=0, le=2000)
-    forklifts: int = param(0, "forklifts driving between pick stations and the dock", ge=0, le=200)
+    workers: int = param(
+        0, "workers walking between pick stations and the dock", ge=0, le=2000, unit="count"
+    )
+    forklifts: int = param(
+        0, "forklifts driving between pick stations and the dock", ge=0, le=200, unit="count"
+    )
     standing: tuple[tuple[float, float], ...] = param(
         (),
         "[[x_m, y_m], ...]: extra workers who stand at these points (snapped to the nearest "
         "aisle) for the whole run",
+        unit="m",
     )
     near_miss_m: float = param(
         0.5,
@@ -44,7 +49,11 @@ class HumansConfig:
         (10.0, 40.0), "[min, max]: how long a worker stays at a pick station (s)", ge=0
     )
     stations: int = param(
-        12, "pick stations (aisle spots next to shelves) workers walk to", ge=1, le=1000
+        12,
+        "pick stations (aisle spots next to shelves) workers walk to",
+        ge=1,
+        le=1000,
+        unit="count",
     )
     forklift_size_m: tuple[float, float] = param(
         (2.3, 1.1), "[length, width] of a forklift (m)", gt=0, le=10.0

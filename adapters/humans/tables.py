@@ -8,6 +8,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -15,6 +16,7 @@ import numpy as np
 from adapters.humans.settings import HumansConfig
 from adapters.tasks.source import TaskSourceAdapter
 from cosim.core.adapter import RunContext
+from cosim.core.summary import SummaryKey
 from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns
 from models.fleet.kinematics import FleetState
@@ -23,6 +25,36 @@ from models.tasks.book import TaskStatus
 
 if TYPE_CHECKING:
     from adapters.humans.crowd import People
+
+_WITH_TASKS = "robots serve tasks (task_source runs)"
+HUMANS_SUMMARY: Mapping[str, SummaryKey] = {
+    "humans_tasks_met_people": SummaryKey(
+        "count",
+        "completed tasks whose robot had a near miss or a stop caused by people while serving them",
+        when=_WITH_TASKS,
+    ),
+    "humans_task_latency_met_people_s": SummaryKey(
+        "s", "mean task latency of those tasks (null: none)", when=_WITH_TASKS
+    ),
+    "humans_task_latency_clear_s": SummaryKey(
+        "s", "mean task latency of the other completed tasks (null: none)", when=_WITH_TASKS
+    ),
+    "humans_seen": SummaryKey("count", "people and forklifts that took part at some time"),
+    "humans_min_distance_m": SummaryKey(
+        "m", "smallest distance between a robot and a person, footprint to footprint (null: none)"
+    ),
+    "humans_near_misses": SummaryKey(
+        "count", "times a robot and a person came closer than humans.near_miss_m"
+    ),
+    "humans_robot_stops": SummaryKey(
+        "count", "times a robot halted with a person within humans.stop_radius_m"
+    ),
+    "humans_collisions": SummaryKey("count", "contacts between a robot and a person or forklift"),
+    "humans_collisions_robot_moving": SummaryKey(
+        "count", "of those, contacts while the robot was driving"
+    ),
+}
+"""The summary keys :meth:`HumanRecords.summary` writes."""
 
 HUMANS = TableSpec(
     "humans",

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -25,6 +25,7 @@ from adapters.mapping.recording import (
     read_recording,
 )
 from cosim.core.errors import BagError
+from cosim.core.summary import SummaryKey
 from models.geometry.se2 import compose, relative
 from models.mapping.grid import MAX_CELLS, LogOddsMap, MapGeometry
 from models.mapping.loop_params import LoopParams
@@ -40,6 +41,35 @@ RESOLUTION_M = (0.01, 1.0)
 nothing more, and a cell coarser than the matcher's 0.3 m window leaves nothing to match."""
 Progress = Callable[[float, float, float], None]
 """(recording time processed s, recording duration s, wall s)."""
+_WITH_REFERENCE = "a reference topic is given (--reference) with 2 poses or more"
+SUMMARY_KEYS: Mapping[str, SummaryKey] = {
+    "bag": SummaryKey("text", "the recording mapped"),
+    "scans": SummaryKey("count", "scans mapped"),
+    "scans_outside_odometry": SummaryKey(
+        "count", "scans outside the odometry's time span, left out"
+    ),
+    "map_updates": SummaryKey("count", "scans that updated the map"),
+    "matched": SummaryKey("count", "of those, updates whose scan match moved the pose"),
+    "loop_closures": SummaryKey("count", "loop closures added to the pose graph"),
+    "loop_closures_not_needed": SummaryKey(
+        "count", "verified loop closures left out: the estimate agreed already"
+    ),
+    "recording_s": SummaryKey("s", "time the recording's scans span"),
+    "wall_time_s": SummaryKey("s", "wall-clock time the mapping took", volatile=True),
+    "real_time_factor": SummaryKey(
+        "ratio", "recording seconds mapped per wall-clock second", volatile=True
+    ),
+    "ate_m": SummaryKey(
+        "m",
+        "RMS position error of the estimate against the reference, aligned",
+        when=_WITH_REFERENCE,
+    ),
+    "ate_odom_m": SummaryKey("m", "the same of the odometry alone", when=_WITH_REFERENCE),
+    "reference_poses": SummaryKey(
+        "count", "reference poses the errors are measured at", when=_WITH_REFERENCE
+    ),
+}
+"""The keys of the ``summary.json`` that ``cosim map`` writes (:attr:`RecordingMap.summary`)."""
 
 
 @dataclass

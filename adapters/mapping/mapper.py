@@ -27,7 +27,13 @@ from adapters.fleet.topics import odom_topic
 from adapters.mapping.contract import MAP_SHARING, MapSharing, SharingContext
 from adapters.mapping.geometry import map_geometry
 from adapters.mapping.settings import MappingConfig
-from adapters.mapping.tables import MAP_MERGES, MAP_QUALITY, SCAN_MATCHES, MappingRecords
+from adapters.mapping.tables import (
+    MAP_MERGES,
+    MAP_QUALITY,
+    MAPPING_SUMMARY,
+    SCAN_MATCHES,
+    MappingRecords,
+)
 from adapters.mapping.topics import FLEET_MAP, correction_topic, map_topic
 from adapters.sensing.topics import scan_topic
 from cosim.core.adapter import RunContext
@@ -42,6 +48,7 @@ from cosim.core.messages import (
     TFMessage,
     Transform,
 )
+from cosim.core.summary import SummaryKey
 from cosim.core.table import TableSpec
 from cosim.core.timebase import period_ns
 from cosim.scenario.sections import LidarConfig
@@ -103,6 +110,14 @@ class MappingAdapter:
     requires: ClassVar[tuple[str, ...]] = ("world", "fleet", "lidar", "network")
     tables: ClassVar[tuple[TableSpec, ...]] = (MAP_QUALITY, SCAN_MATCHES, MAP_MERGES)
     """The tables it writes (documented in the table reference)."""
+    summary_keys: ClassVar[Mapping[str, SummaryKey]] = {
+        **MAPPING_SUMMARY,
+        "map_loop_closures": SummaryKey("count", "loop closures added to the robots' pose graphs"),
+        "map_loop_closures_not_needed": SummaryKey(
+            "count", "verified loop closures left out: the estimate agreed already"
+        ),
+    }
+    """The summary keys :meth:`finish` writes (documented in the summary reference)."""
 
     def __init__(self, run: RunContext) -> None:
         self.cfg = run.settings(MappingConfig)

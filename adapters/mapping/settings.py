@@ -62,6 +62,7 @@ class MappingConfig:
         "over 10 seeds where 0 gave 0.82-0.90 (cosim map uses 0: real odometry is noisier)",
         ge=0,
         le=1,
+        unit="score (0..1)",
     )
     map_update_interval_s: float = param(
         5.0, "period of each robot's map going to its navigation and the bag (s)", gt=0
@@ -88,6 +89,7 @@ class MappingConfig:
         "by at least this (squared Mahalanobis distance, its own covariance; 7.81 is the 95 % "
         "point of chi-square with 3 degrees of freedom; 0 adds every verified closure)",
         ge=0,
+        unit="χ² (3 dof)",
     )
 
     def problems(self) -> Iterator[Problem]:

@@ -17,17 +17,50 @@ Tables:
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
 from cosim.core.recorder import Recorder
+from cosim.core.summary import SummaryKey
 from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S
 from models.geometry.occupancy import OccupancyGrid, rasterize_boxes
 from models.mapping.grid import LogOddsMap, MapGeometry
 from models.mapping.quality import Int8Array, MapScores, map_scores, observable
 from models.world.warehouse import Warehouse
+
+MAPPING_SUMMARY: Mapping[str, SummaryKey] = {
+    "map_coverage": SummaryKey(
+        "fraction", "the fleet's map at the end: share of the observable cells it knows"
+    ),
+    "map_iou": SummaryKey(
+        "fraction",
+        "the fleet's map at the end: occupied cells against the truth over the explored "
+        "area, one cell of tolerance (intersection over union)",
+    ),
+    "map_accuracy": SummaryKey(
+        "fraction", "the fleet's map at the end: share of the known cells right"
+    ),
+    "map_iou_strict": SummaryKey("fraction", "map_iou without the cell of tolerance"),
+    "map_ate_m": SummaryKey(
+        "m", "RMS position error of the robots' estimated poses over every map update"
+    ),
+    "map_ate_odom_m": SummaryKey("m", "RMS position error of odometry alone over the same updates"),
+    "map_updates": SummaryKey("count", "scans integrated into the robots' maps"),
+    "map_matched_share": SummaryKey(
+        "fraction", "of the map updates, those whose scan match was accepted (null: none)"
+    ),
+    "map_share_messages": SummaryKey("count", "scans or map updates sent to neighbours"),
+    "map_share_bytes": SummaryKey("bytes", "wire size of those messages, summed"),
+    "map_merges": SummaryKey("count", "scans or map updates a robot added from a neighbour"),
+    "map_merge_delay_s_mean": SummaryKey(
+        "s", "time from the sender's stamp to the merge, mean (null: no merge)"
+    ),
+}
+"""The summary keys :meth:`MappingRecords.summary` writes (the fleet's map scores are null
+before its first quality sample)."""
 
 MAP_QUALITY = TableSpec(
     "map_quality",
@@ -43,6 +76,12 @@ MAP_QUALITY = TableSpec(
         "iou_strict": "iou without the cell of tolerance",
     },
     categorical=("robot",),
+    units={
+        "coverage": "fraction",
+        "iou": "fraction",
+        "accuracy": "fraction",
+        "iou_strict": "fraction",
+    },
 )
 QUALITY_COLUMNS = tuple(MAP_QUALITY.columns)
 SCAN_MATCHES = TableSpec(
@@ -60,6 +99,7 @@ SCAN_MATCHES = TableSpec(
         "matched": "whether the match was accepted (else odometry was kept)",
     },
     categorical=("robot",),
+    units={"score": "fraction"},
 )
 MATCH_COLUMNS = tuple(SCAN_MATCHES.columns)
 MAP_MERGES = TableSpec(
@@ -75,6 +115,7 @@ MAP_MERGES = TableSpec(
         "cells": "cells of the robot's map it changed",
     },
     categorical=("robot", "source", "kind"),
+    units={"bytes": "bytes", "cells": "count"},
 )
 MERGE_COLUMNS = tuple(MAP_MERGES.columns)
 FLEET = "fleet"

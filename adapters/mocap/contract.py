@@ -123,7 +123,11 @@ class PoseSource(Protocol):
         ...
 
     def summary(self) -> Mapping[str, Any]:
-        """``mocap_*`` counts of its own for the run's summary."""
+        """``mocap_*`` counts of its own for the run's summary.
+
+        Each key is declared, with its unit and meaning, in the class's ``summary_keys``
+        (a mapping of key to :class:`cosim.core.summary.SummaryKey`).
+        """
         ...
 
 

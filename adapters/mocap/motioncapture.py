@@ -16,6 +16,7 @@ from adapters.mocap.feed import SYSTEMS, MotionCaptureFeed, mock_bodies
 from adapters.mocap.live import PolledSource, Sample
 from adapters.mocap.settings import MocapConfig
 from cosim.core.adapter import RunContext
+from cosim.core.summary import SummaryKey
 from cosim.scenario.fields import Problem
 from models.fleet.kinematics import FleetState
 
@@ -24,6 +25,10 @@ class MotionCaptureSource(PolledSource):
     """Rigid bodies of a live mocap system, one per tracked robot (see the module)."""
 
     name: ClassVar[str] = "motioncapture"
+    summary_keys: ClassVar[Mapping[str, SummaryKey]] = {
+        "mocap_missing_bodies": SummaryKey("count", "tracked rigid bodies never seen in a frame"),
+    }
+    """The summary keys :meth:`summary` writes (documented in the summary reference)."""
     uses_dds: ClassVar[bool] = False
     keys: ClassVar[tuple[str, ...]] = ("bodies",)
     settings_hint: ClassVar[str] = "mocap.system, mocap.hostname and mocap.bodies"

@@ -20,6 +20,7 @@ from adapters.ros2dds.session import DdsSession, dds_session
 from adapters.ros2dds.types import PoseStamped as DdsPoseStamped
 from adapters.ros2dds.types import planar_pose
 from cosim.core.adapter import RunContext
+from cosim.core.summary import SummaryKey
 from cosim.scenario.fields import Problem
 
 
@@ -42,6 +43,13 @@ class Ros2PoseSource(PolledSource):
     """PoseStamped topics over DDS, one per tracked robot (see the module)."""
 
     name: ClassVar[str] = "ros2"
+    summary_keys: ClassVar[Mapping[str, SummaryKey]] = {
+        "mocap_dds_invalid": SummaryKey(
+            "count", "PoseStamped samples that hold no planar pose (refused before the intake)"
+        ),
+        "mocap_dds_malformed": SummaryKey("count", "DDS samples that failed to deserialize"),
+    }
+    """The summary keys :meth:`summary` writes (documented in the summary reference)."""
     uses_dds: ClassVar[bool] = True
     keys: ClassVar[tuple[str, ...]] = ("bodies",)
     settings_hint: ClassVar[str] = "mocap.bodies or mocap.topic_pattern, and physical.dds_domain"

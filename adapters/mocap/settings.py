@@ -64,7 +64,11 @@ class MocapConfig:
     noise_std_m: float = param(0.001, "simulated: Gaussian position noise per axis (m)", ge=0)
     noise_std_rad: float = param(0.002, "simulated: Gaussian yaw noise (rad)", ge=0)
     dropout: float = param(
-        0.0, "simulated: probability that a body is missing from a frame", ge=0, le=1
+        0.0,
+        "simulated: probability that a body is missing from a frame",
+        ge=0,
+        le=1,
+        unit="probability",
     )
     max_age_ms: float = param(
         200.0, "a robot whose newest pose is older than this stops (zero velocity) (ms)", gt=0

@@ -23,11 +23,12 @@ from typing import Any, ClassVar
 from adapters.mocap.contract import PoseSource, SourceContext
 from adapters.mocap.intake import PoseIntake
 from adapters.mocap.settings import NO_SOURCE, MocapConfig
-from adapters.mocap.tables import MOCAP, MocapRecords
+from adapters.mocap.tables import MOCAP, MOCAP_SUMMARY, MocapRecords
 from adapters.mocap.tracking import tracked_bodies
 from cosim.core.adapter import RunContext
 from cosim.core.errors import ConfigError
 from cosim.core.hosts import HostKind
+from cosim.core.summary import SummaryKey
 from cosim.core.table import TableSpec
 from models.fleet.kinematics import FleetState
 
@@ -41,6 +42,9 @@ class MocapAdapter:
     requires: ClassVar[tuple[str, ...]] = ("fleet",)
     tables: ClassVar[tuple[TableSpec, ...]] = (MOCAP,)
     """The tables it writes (documented in the table reference)."""
+    summary_keys: ClassVar[Mapping[str, SummaryKey]] = MOCAP_SUMMARY
+    """The summary keys :meth:`finish` writes; the source's own are declared by the source
+    class (documented in the summary reference)."""
 
     def __init__(self, run: RunContext) -> None:
         self.cfg = cfg = run.settings(MocapConfig)

@@ -9,9 +9,11 @@ stopped because their newest pose was too old, and when they got a fresh one aga
 from __future__ import annotations
 
 from collections import Counter
+from collections.abc import Mapping
 from typing import Any
 
 from cosim.core.adapter import RunContext
+from cosim.core.summary import SummaryKey
 from cosim.core.table import Table, TableSpec
 from cosim.core.timebase import NS_PER_S
 
@@ -28,6 +30,24 @@ MOCAP = TableSpec(
     categorical=("robot", "event"),
 )
 MOCAP_COLUMNS = tuple(MOCAP.columns)
+
+MOCAP_SUMMARY: Mapping[str, SummaryKey] = {
+    "mocap_poses": SummaryKey("count", "measured poses accepted and published"),
+    "mocap_dropouts": SummaryKey(
+        "count", "bodies missing from a frame (simulated source: mocap.dropout)"
+    ),
+    "mocap_rejected_jumps": SummaryKey(
+        "count", "poses rejected as a jump beyond what the robot can drive"
+    ),
+    "mocap_rejected_out_of_order": SummaryKey("count", "poses rejected as stamped out of order"),
+    "mocap_invalid": SummaryKey("count", "samples rejected as no pose (NaN, not finite)"),
+    "mocap_rejected_off_map": SummaryKey("count", "poses rejected as outside the world"),
+    "mocap_stale_stops": SummaryKey(
+        "count", "robots stopped because their newest pose was older than mocap.max_age_ms"
+    ),
+}
+"""The summary keys :meth:`MocapRecords.summary` writes (once, to the first adapter that
+asks: ``mocap``, or ``physical`` when no mocap adapter runs)."""
 
 EVENTS = ("jump", "out_of_order", "invalid", "off_map", "on_map", "stale", "fresh")
 """The events of ``tables/mocap``."""

@@ -24,6 +24,7 @@ from cosim.core.bus import Envelope
 from cosim.core.errors import ConfigError
 from cosim.core.hosts import HostId
 from cosim.core.messages import Message, NavGoal, NavStatus
+from cosim.core.summary import SummaryKey
 from cosim.core.timebase import s_to_ns
 from cosim.scenario.sections import RobotsConfig, WorldConfig
 from models.fleet.kinematics import FleetState
@@ -40,6 +41,10 @@ class GoalsAdapter:
 
     name: ClassVar[str] = "goals"
     requires: ClassVar[tuple[str, ...]] = ("navigation",)
+    summary_keys: ClassVar[Mapping[str, SummaryKey]] = {
+        "goals_sent": SummaryKey("count", "navigation goals sent to the robots"),
+    }
+    """The summary keys :meth:`finish` writes (documented in the summary reference)."""
 
     def __init__(self, run: RunContext) -> None:
         fleet = run.service(FleetState)

@@ -39,7 +39,7 @@ class NavigationConfig:
     robots_layer_timeout_s: float = param(1.0, "forget a robot not heard from for (s)", gt=0)
     resolution_m: float = param(0.1, "costmap cell size (m)", gt=0, le=1)
     inflation_radius_m: float = param(1.0, "inflation radius (m)", gt=0, le=10.0)
-    cost_scaling: float = param(3.0, "inflation cost scaling factor (1/m)", gt=0)
+    cost_scaling: float = param(3.0, "inflation cost scaling factor (1/m)", gt=0, unit="1/m")
     lookahead_m: float = param(1.0, "carrot distance ahead on the path (m)", gt=0)
     goal_tolerance_m: float = param(0.25, "distance at which a goal is reached (m)", gt=0)
     obstacle_memory_s: float = param(3.0, "how long lidar obstacles stay in the costmap (s)", ge=0)
@@ -63,4 +63,5 @@ class NavigationConfig:
         (),
         "driver 'navigation': a series of goals [[x_m, y_m], ...] in map, visited in order "
         "and round again (robot i starts at goal i); empty: random reachable goals",
+        unit="m",
     )

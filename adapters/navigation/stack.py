@@ -36,9 +36,10 @@ from adapters.navigation.contract import (
 from adapters.navigation.fleet_traffic import FleetTraffic
 from adapters.navigation.parts import build_parts
 from adapters.navigation.settings import NavigationConfig
-from adapters.navigation.tables import NAVIGATION
+from adapters.navigation.tables import NAV_SUMMARY, NAVIGATION
 from cosim.core.adapter import RunContext
 from cosim.core.kernel import Stage
+from cosim.core.summary import SummaryKey
 from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns
 from cosim.scenario.model import Scenario
@@ -62,6 +63,19 @@ class NavigationAdapter:
     requires: ClassVar[tuple[str, ...]] = ("world", "fleet", "lidar")
     tables: ClassVar[tuple[TableSpec, ...]] = (NAVIGATION,)
     """The tables it writes (documented in the table reference)."""
+    summary_keys: ClassVar[Mapping[str, SummaryKey]] = {
+        **NAV_SUMMARY,
+        "goals_active_at_end": SummaryKey("count", "goals still being driven to at the end"),
+        "controller_commands_clipped": SummaryKey(
+            "count", "local controller commands clipped to the robots' drive limits"
+        ),
+        "goals_missed": SummaryKey(
+            "count",
+            "goals taken on that were neither reached, nor unreachable, nor still being "
+            "driven to at the end (abandoned after a stuck report)",
+        ),
+    }
+    """The summary keys :meth:`finish` writes (documented in the summary reference)."""
 
     @staticmethod
     def check_scenario(scenario: Scenario) -> None:

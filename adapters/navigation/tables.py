@@ -1,4 +1,4 @@
-"""Navigation records: ``tables/navigation`` rows and the navigation summary.
+"""Navigation records: ``tables/navigation`` rows and the navigation summary (its keys).
 
 ``plan_ms`` is the wall-clock time of a plan, a column that is not a function of the
 scenario and seed; it is registered as volatile, and runs are compared without it
@@ -8,12 +8,14 @@ scenario and seed; it is registered as volatile, and runs are compared without i
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
 from adapters.navigation.recovery import STUCK_KINDS
 from cosim.core.recorder import Recorder
+from cosim.core.summary import SummaryKey
 from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S
 
@@ -35,6 +37,33 @@ NAVIGATION = TableSpec(
     volatile=("plan_ms",),
 )
 NAV_COLUMNS = tuple(NAVIGATION.columns)
+
+_STUCK_WHY = {
+    "halted": "it had barely moved since its last progress",
+    "detoured": "it drove, but its way left grew longer than its best",
+    "slowed": "it drove on its way, slowed by traffic",
+}
+NAV_SUMMARY: Mapping[str, SummaryKey] = {
+    "goals": SummaryKey("count", "goals the robots took on (goal rows of tables/navigation)"),
+    "arrivals": SummaryKey("count", "goals reached"),
+    "mean_time_to_goal_s": SummaryKey(
+        "s", "time from taking a goal to reaching it, mean over arrivals (null: none)"
+    ),
+    "path_length_ratio": SummaryKey(
+        "ratio",
+        "distance driven to a goal over its shortest path, mean over arrivals more than "
+        "0.5 m away (null: none)",
+    ),
+    "deadlocks": SummaryKey("count", "stuck reports: no progress for navigation.stuck_timeout_s"),
+    **{
+        f"stuck_{kind}": SummaryKey("count", f"stuck reports where {_STUCK_WHY[kind]}")
+        for kind in STUCK_KINDS
+    },
+    "goals_unreachable": SummaryKey("count", "goals dropped as unreachable"),
+    "replans": SummaryKey("count", "global plans made again for a goal"),
+    "recoveries": SummaryKey("count", "recovery steps of robots that could not go on"),
+}
+"""The summary keys :meth:`NavRecords.summary` writes."""
 
 
 class NavRecords:

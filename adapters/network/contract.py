@@ -72,6 +72,9 @@ class NetworkBackend(Protocol):
     Attributes:
         name: the registered name (``network.backend``).
         tables: the tables it writes (for the table reference).
+
+    It declares the keys its :meth:`finish` returns in a ``summary_keys`` class attribute
+    (key -> :class:`cosim.core.summary.SummaryKey`), for the summary reference.
     """
 
     name: ClassVar[str]

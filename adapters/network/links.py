@@ -34,6 +34,7 @@ from cosim.core.errors import ConfigError
 from cosim.core.hosts import HostId, HostKind
 from cosim.core.kernel import Stage
 from cosim.core.link import AllDelivered, Transfer
+from cosim.core.summary import SummaryKey
 from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns, s_to_ns
 from cosim.scenario.fields import model_problem
@@ -149,6 +150,26 @@ class LinksBackend(ModelLink):
 
     name: ClassVar[str] = "links"
     tables: ClassVar[tuple[TableSpec, ...]] = (LINKS,)
+    summary_keys: ClassVar[Mapping[str, SummaryKey]] = {
+        "link_changes": SummaryKey(
+            "count",
+            "links between two hosts that came up (those of the start included) or went "
+            "down: the rows of tables/links",
+        ),
+        "loss_rate_configured": SummaryKey(
+            "fraction",
+            "the long-run loss rate of each link's loss model as configured (not measured)",
+        ),
+        **{
+            f"latency_ms_p{q}": SummaryKey(
+                "ms",
+                f"{said} one-way latency of the messages delivered between two hosts "
+                "(null: none crossed the network)",
+            )
+            for q, said in ((50, "median"), (95, "95th percentile"), (99, "99th percentile"))
+        },
+    }
+    """The summary keys :meth:`finish` writes (documented in the summary reference)."""
     keys: ClassVar[tuple[str, ...]] = (
         "topology", "edge_prob", "edges", "latency_model", "latency_ms", "jitter_ms",
         "latency_csv", "reorder", "loss_model", "loss_prob", "ge_p", "ge_r", "ge_loss_bad",

@@ -147,21 +147,27 @@ class NetworkConfig:
         registry="cosim.loss_models",
     )
     loss_prob: float = param(0.0, "bernoulli: loss probability per message", ge=0, le=1)
-    ge_p: float = param(0.0, "gilbert_elliott: P(good -> bad) per message (netem p)", ge=0, le=1)
-    ge_r: float = param(1.0, "gilbert_elliott: P(bad -> good) per message (netem r)", ge=0, le=1)
+    ge_p: float = param(
+        0.0, "gilbert_elliott: P(good -> bad) per message (netem p)", ge=0, le=1, unit="probability"
+    )
+    ge_r: float = param(
+        1.0, "gilbert_elliott: P(bad -> good) per message (netem r)", ge=0, le=1, unit="probability"
+    )
     ge_loss_bad: float = param(
-        1.0, "gilbert_elliott: loss probability in bad (netem 1-h)", ge=0, le=1
+        1.0, "gilbert_elliott: loss probability in bad (netem 1-h)", ge=0, le=1, unit="probability"
     )
     ge_loss_good: float = param(
-        0.0, "gilbert_elliott: loss probability in good (netem 1-k)", ge=0, le=1
+        0.0, "gilbert_elliott: loss probability in good (netem 1-k)", ge=0, le=1, unit="probability"
     )
     bandwidth_mbps: float = param(0.0, "sending rate of every host (Mbit/s), 0 = unlimited", ge=0)
     queue_packets: int = param(
-        100, "messages that may wait at a sending interface", ge=1, le=1_000_000
+        100, "messages that may wait at a sending interface", ge=1, le=1_000_000, unit="count"
     )
     range_m: float = param(0.0, "robot-to-robot range cut-off (m), 0 = unlimited", ge=0)
     path_loss: bool = param(False, "log-distance path loss with shadowing between robots")
-    path_loss_exponent: float = param(3.0, "path loss exponent (indoor obstructed ~3)", gt=0)
+    path_loss_exponent: float = param(
+        3.0, "path loss exponent (indoor obstructed ~3)", gt=0, unit="exponent"
+    )
     tx_power_dbm: float = param(20.0, "transmit power (dBm)")
     ref_loss_db: float = param(
         46.7, "path loss at 1 m (dB): free space at 5.18 GHz, Wi-Fi channel 36", ge=0

@@ -34,6 +34,7 @@ from adapters.fleet.mirror import Mirrors
 from adapters.fleet.topics import cmd_vel_topic, odom_topic
 from adapters.mocap.intake import PoseIntake
 from adapters.mocap.settings import MocapConfig
+from adapters.mocap.tables import MOCAP_SUMMARY
 from adapters.mocap.tracking import live_sources, source_of, tracked_bodies
 from adapters.navigation.topics import goal_pose_topic, goal_topic
 from adapters.physical.settings import PhysicalConfig
@@ -50,6 +51,7 @@ from cosim.core.kernel import Stage
 from cosim.core.messages import LaserScan, Message, PoseStamped, Twist
 from cosim.core.messages.navigation import NavGoal
 from cosim.core.recorder import Recorder
+from cosim.core.summary import SummaryKey
 from cosim.core.timebase import NS_PER_S, period_ns, s_to_ns
 from models.fleet.kinematics import FleetState
 
@@ -114,6 +116,31 @@ class PhysicalAdapter:
 
     name: ClassVar[str] = "physical"
     requires: ClassVar[tuple[str, ...]] = ("fleet", "lidar")
+    summary_keys: ClassVar[Mapping[str, SummaryKey]] = {
+        "physical_robots": SummaryKey("count", "physical robots in the run"),
+        "physical_dds_domain": SummaryKey(
+            "id", "the DDS domain the run joined (null: it never joined one)"
+        ),
+        "physical_poses": SummaryKey("count", "pose updates of the physical robots taken in"),
+        "physical_scans_sent": SummaryKey("count", "virtual lidar scans sent to the robots"),
+        "physical_commands_sent": SummaryKey(
+            "count", "velocity commands or goals sent to the robots"
+        ),
+        "physical_invalid_samples": SummaryKey(
+            "count", "odometry samples from the robots that held no planar pose"
+        ),
+        "physical_malformed_samples": SummaryKey(
+            "count", "odometry samples that failed to deserialize"
+        ),
+        "physical_foreign_writers": SummaryKey(
+            "count", "other DDS writers on the robots' command and odometry topics"
+        ),
+        **{
+            key: dataclasses.replace(value, when="physical.pose = 'odom' without a mocap adapter")
+            for key, value in MOCAP_SUMMARY.items()
+        },
+    }
+    """The summary keys :meth:`finish` writes (documented in the summary reference)."""
 
     def __init__(self, run: RunContext) -> None:
         self.cfg = run.settings(PhysicalConfig)

@@ -30,6 +30,7 @@ class PhysicalConfig:
         "side never hear each other's robots; the run says which)",
         ge=0,
         le=232,
+        unit="id",
     )
     interface: str = param(
         "", "network interface or address for DDS; empty keeps DDS on loopback (127.0.0.1)"

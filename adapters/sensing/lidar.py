@@ -21,6 +21,7 @@ from cosim.core.hosts import HostId
 from cosim.core.kernel import Stage
 from cosim.core.messages import LaserScan
 from cosim.core.rng import BlockDraws
+from cosim.core.summary import SummaryKey
 from cosim.core.timebase import period_ns
 from cosim.scenario.sections import LidarConfig
 from models.fleet.kinematics import FleetState
@@ -35,6 +36,11 @@ class LidarAdapter:
 
     name: ClassVar[str] = "lidar"
     requires: ClassVar[tuple[str, ...]] = ("world", "fleet")
+    summary_keys: ClassVar[Mapping[str, SummaryKey]] = {
+        "lidar_scans": SummaryKey("count", "scan instants (every robot scans at each)"),
+        "lidar_rays": SummaryKey("count", "rays cast: scans x robots x beams"),
+    }
+    """The summary keys :meth:`finish` writes (documented in the summary reference)."""
 
     def __init__(self, run: RunContext) -> None:
         cfg = run.settings(LidarConfig)

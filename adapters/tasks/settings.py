@@ -19,8 +19,10 @@ class TasksConfig:
     ORDER: ClassVar[int] = 70
     """Where the section comes in a resolved scenario and in the adapters' order."""
 
-    initial: int = param(4, "tasks open at the start", ge=1, le=100_000)
-    max_total: int = param(0, "tasks created over the run, 0 = unlimited", ge=0, le=10_000_000)
+    initial: int = param(4, "tasks open at the start", ge=1, le=100_000, unit="count")
+    max_total: int = param(
+        0, "tasks created over the run, 0 = unlimited", ge=0, le=10_000_000, unit="count"
+    )
     eligibility_prob: float = param(
         1.0,
         "probability that a robot may serve a task (ChoiRbot's example uses a subset)",

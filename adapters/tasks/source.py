@@ -48,6 +48,7 @@ from cosim.core.messages import (
     TaskOrder,
     TaskSet,
 )
+from cosim.core.summary import SummaryKey
 from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns, s_to_ns
 from cosim.scenario.sections import RobotsConfig, WorldConfig
@@ -72,6 +73,7 @@ TASKS_TABLE = TableSpec(
         "reassignments": "how often its claim passed from one robot to another",
     },
     categorical=("robot",),
+    units={"task": "id", "reassignments": "count"},
 )
 TASK_COLUMNS = tuple(TASKS_TABLE.columns)
 ANNOUNCE_HZ = 5.0
@@ -85,6 +87,25 @@ class TaskSourceAdapter:
     requires: ClassVar[tuple[str, ...]] = ("world", "fleet", "network", "navigation")
     tables: ClassVar[tuple[TableSpec, ...]] = (TASKS_TABLE,)
     """The tables it writes (documented in the table reference)."""
+    summary_keys: ClassVar[Mapping[str, SummaryKey]] = {
+        "tasks_created": SummaryKey("count", "tasks created over the run"),
+        "tasks_completed": SummaryKey("count", "tasks served to the end"),
+        "tasks_per_min": SummaryKey(
+            "1/min", "tasks completed per minute of simulated time (null: no time ran)"
+        ),
+        "mean_task_latency_s": SummaryKey(
+            "s",
+            "time from a task's creation to its completion, mean over completed tasks (null: none)",
+        ),
+        "conflicts": SummaryKey(
+            "count", "claims on a task another robot held (the better claim kept)"
+        ),
+        "services_refused": SummaryKey(
+            "count", "requests to serve a task refused (not eligible, taken, claimed by another)"
+        ),
+        "epochs": SummaryKey("count", "task sets announced to the robots"),
+    }
+    """The summary keys :meth:`finish` writes (documented in the summary reference)."""
 
     def __init__(self, run: RunContext) -> None:
         self.cfg = run.settings(TasksConfig)

@@ -26,6 +26,7 @@ from adapters.unity.topics import pose_bus_topic
 from cosim.core.adapter import RunContext
 from cosim.core.bus import Envelope
 from cosim.core.messages import Message, PoseStamped
+from cosim.core.summary import SummaryKey
 from cosim.scenario.fields import Problem
 
 
@@ -33,6 +34,15 @@ class UnityPoseSource(PolledSource):
     """Poses of the tracked robots, published by Unity scenes (see the module docstring)."""
 
     name: ClassVar[str] = "unity"
+    summary_keys: ClassVar[Mapping[str, SummaryKey]] = {
+        "mocap_unity_poses": SummaryKey(
+            "count", "poses received from Unity scenes (before the intake's checks)"
+        ),
+        "mocap_unity_not_in_map": SummaryKey(
+            "count", "of those, poses refused for a frame other than map"
+        ),
+    }
+    """The summary keys :meth:`summary` writes (documented in the summary reference)."""
     uses_dds: ClassVar[bool] = False
     keys: ClassVar[tuple[str, ...]] = ("bodies",)
     settings_hint: ClassVar[str] = "mocap.bodies or mocap.topic_pattern, and cosim run --unity"

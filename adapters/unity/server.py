@@ -17,9 +17,9 @@ import itertools
 import queue
 import socket
 import threading
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Protocol
+from typing import ClassVar, Protocol
 
 from adapters.drivers.topics import teleop_topic
 from adapters.navigation.topics import goal_topic
@@ -42,6 +42,7 @@ from cosim.core.errors import BridgeError
 from cosim.core.hosts import HostId
 from cosim.core.kernel import Stage
 from cosim.core.messages import NavGoal, PoseStamped, Twist
+from cosim.core.summary import SummaryKey
 
 DRAIN_EVERY_NS = 50_000_000
 """Goals from Unity enter the run at most 50 ms (simulated) after they arrived."""
@@ -94,6 +95,30 @@ class UnitySink:
         options: host and port.
         bus: the run's bus (goals are published on it; its kernel drains them).
     """
+
+    summary_keys: ClassVar[Mapping[str, SummaryKey]] = {
+        "unity_clients": SummaryKey("count", "connections Unity scenes opened"),
+        "unity_frames_received": SummaryKey("count", "ROS-TCP frames received from the scenes"),
+        "unity_frames_rejected": SummaryKey(
+            "count", "frames refused (malformed, or an unknown topic or type)"
+        ),
+        "unity_goals": SummaryKey("count", "navigation goals taken from the scenes"),
+        "unity_frames_dropped": SummaryKey(
+            "count",
+            "frames a connection too slow to take them missed",
+            when="a frame was dropped",
+        ),
+        "unity_twists": SummaryKey(
+            "count",
+            "velocity commands taken from the scenes",
+            when="robots.driver = 'teleop'",
+        ),
+        "unity_poses": SummaryKey(
+            "count",
+            "tracked poses taken from the scenes",
+            when="mocap.source = 'unity'",
+        ),
+    }
 
     def __init__(self, options: UnityOptions, bus: Bus) -> None:
         self.options = options

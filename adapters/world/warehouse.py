@@ -10,6 +10,7 @@ import numpy as np
 from cosim.core.adapter import RunContext, ScenarioView
 from cosim.core.hosts import BASE_HOST, HostKind
 from cosim.core.rng import RngStreams
+from cosim.core.summary import SummaryKey
 from cosim.scenario.fields import model_problem
 from cosim.scenario.sections import RobotsConfig, WorldConfig
 from models.errors import ModelError
@@ -67,6 +68,10 @@ class WorldAdapter:
 
     name: ClassVar[str] = "world"
     requires: ClassVar[tuple[str, ...]] = ()
+    summary_keys: ClassVar[Mapping[str, SummaryKey]] = {
+        "shelves": SummaryKey("count", "shelves in the hall"),
+    }
+    """The summary keys :meth:`finish` writes (documented in the summary reference)."""
 
     def __init__(self, run: RunContext) -> None:
         self.warehouse = scenario_warehouse(run.scenario, run.rng.stream(WORLD_STREAM))

@@ -1,7 +1,8 @@
 """``cosim check-plugin NAME``: the checks cosim runs on its built-ins, run on one plugin.
 
-One line per check (``ok``, ``FAIL`` or ``skip``, its name, what was found or why), then
-a last line counting them. Exit status: 0 every check passed or did not apply; 3 a check
+One line per check (``ok``, ``warn``, ``FAIL`` or ``skip``, its name, what was found or
+why), then a last line counting them. Exit status: 0 every check passed (a warning
+breaks nothing: a summary key declared nowhere) or did not apply; 3 a check
 failed (the plugin's code broke its contract or its group's rules, as ``cosim run`` says
 of a plugin whose code failed; a ``--set`` value its scenario refuses fails the
 ``scenario`` check); 2 an unknown or ambiguous NAME, or a ``--set`` of no registered key.
@@ -26,7 +27,8 @@ DESCRIPTION = (
     "defaults and documents every key with the unit in its name; and a short real run in "
     "a small warehouse-random set up for its kind (a protocol with tasks on a network that "
     "loses nothing, a controller with navigation, an adapter added to the scenario, ...) "
-    "finishes, leaves a flat summary, repeats exactly with the same seed and keeps its "
+    "finishes, leaves a flat summary whose every key is declared with its unit (a "
+    "warning otherwise), repeats exactly with the same seed and keeps its "
     "kind's rules (a protocol claims every task within 5 s without conflicts, a "
     "controller's robots stay finite and move, a network backend delivers everything)."
 )
@@ -82,9 +84,14 @@ def check_plugin_command(args: argparse.Namespace) -> int:
         outcomes.append(outcome)
     failed = [o.check for o in outcomes if o.failed]
     skipped = sum(o.verdict.value == "skip" for o in outcomes)
+    warned = sum(o.verdict.value == "warn" for o in outcomes)
     if failed:
         print(f"{target.name}: {len(failed)} of {len(outcomes)} checks failed: {', '.join(failed)}")
         return EXIT_CHECK_FAILED
     passed = len(outcomes) - skipped
-    print(f"{target.name}: {passed} checks passed" + (f", {skipped} skipped" if skipped else ""))
+    print(
+        f"{target.name}: {passed} checks passed"
+        + (f" ({warned} with a warning)" if warned else "")
+        + (f", {skipped} skipped" if skipped else "")
+    )
     return EXIT_ALL_PASSED

@@ -137,7 +137,11 @@ class Adapter(Protocol):
         ...
 
     def finish(self, run: RunContext) -> Mapping[str, Any]:
-        """Return summary metrics (flat, JSON-serializable) at the end of the run."""
+        """Return summary metrics (flat, JSON-serializable) at the end of the run.
+
+        Each key is declared, with its unit and meaning, in the class's ``summary_keys``
+        (see :mod:`cosim.core.summary`), from which the summary reference is generated.
+        """
         ...
 
 
@@ -147,6 +151,10 @@ class AdapterType(Protocol):
     Attributes:
         name: the registered name.
         requires: names of adapters that must be constructed (and started) before.
+
+    A class declares the keys its ``finish`` returns in ``summary_keys`` (a mapping of
+    key to :class:`~cosim.core.summary.SummaryKey`: unit and meaning), and the tables it
+    writes in ``tables``; both go into the generated references.
 
     A class may also declare a static ``check_scenario(scenario)`` that raises
     :class:`~cosim.core.errors.ConfigError` for combinations of sections it cannot run

@@ -61,6 +61,7 @@ MESSAGES = TableSpec(
         "t_recv_ns": "t_recv_s in exact integer nanoseconds; empty when dropped",
     },
     categorical=("src_host", "dst_host", "topic", "status"),
+    units={"bytes": "bytes"},
 )
 EVENTS = TableSpec(
     "events",

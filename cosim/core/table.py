@@ -17,7 +17,7 @@ comparison per row, one key comparison per batch.
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -42,6 +42,9 @@ class TableSpec:
         categorical: columns of repeated strings (written as ``category``).
         volatile: wall-clock columns: the only values that are not a function of the
             scenario and seed (comparisons of runs leave them out).
+        units: the unit of a numeric column whose name cannot carry it (``bytes`` in
+            bytes, ``cost`` in m), or what a unitless one is (``count``, ``fraction``);
+            the table reference shows it, or else the unit the name carries.
     """
 
     name: str
@@ -49,6 +52,7 @@ class TableSpec:
     columns: Mapping[str, str]
     categorical: tuple[str, ...] = ()
     volatile: tuple[str, ...] = ()
+    units: Mapping[str, str] = field(default_factory=dict)
 
 
 class Interner:

@@ -6,6 +6,7 @@ import argparse
 
 from cosim.cli.args import build_parser
 from cosim.cli.exits import EXIT_STATUSES
+from cosim.reference.escaping import cell, code, fenced
 
 
 def _subparsers(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:
@@ -28,22 +29,18 @@ def commands_markdown() -> str:
         "",
         "| status | meaning |",
         "|---|---|",
-        *(f"| {status} | {meaning} |" for status, meaning in EXIT_STATUSES.items()),
+        *(f"| {status} | {cell(meaning)} |" for status, meaning in EXIT_STATUSES.items()),
         "",
-        "```text",
-        parser.format_help().rstrip(),
-        "```",
+        *fenced(parser.format_help().rstrip()),
         "",
     ]
     for name, sub in _subparsers(parser).items():
-        lines += [f"## `cosim {name}`", "", "```text", sub.format_help().rstrip(), "```", ""]
+        lines += [f"## {code(f'cosim {name}')}", "", *fenced(sub.format_help().rstrip()), ""]
         for inner_name, inner in _subparsers(sub).items():
             lines += [
-                f"### `cosim {name} {inner_name}`",
+                f"### {code(f'cosim {name} {inner_name}')}",
                 "",
-                "```text",
-                inner.format_help().rstrip(),
-                "```",
+                *fenced(inner.format_help().rstrip()),
                 "",
             ]
     return "\n".join(lines) + "\n"

@@ -7,15 +7,12 @@ import inspect
 from typing import Any, get_args, get_type_hints
 
 from cosim.core.registry import group_named
+from cosim.reference.escaping import cell, code, text
 from cosim.scenario.fields import UNITS as UNITS  # the reference's unit column, re-exported
-from cosim.scenario.fields import Bounds, describe, implicit_bounds, unit_of
+from cosim.scenario.fields import Bounds, describe, implicit_bounds, key_unit
+from cosim.scenario.fields import unit_of as unit_of
 from cosim.scenario.loader import toml_value
 from cosim.scenario.model import section_classes, section_registry
-
-
-def _cell(text: str) -> str:
-    """Text safe inside a Markdown table cell."""
-    return text.replace("|", "\\|").replace("\n", " ")
 
 
 def _expected(key: str, field: dataclasses.Field[Any], hint: Any) -> str:
@@ -24,18 +21,20 @@ def _expected(key: str, field: dataclasses.Field[Any], hint: Any) -> str:
         group = group_named(group_name)
         names = group.installed().names()
         off = field.metadata.get("off")
-        nothing = f", or `{off}` (none at all)" if off is not None else ""
-        return f"a registered {group.words}: {', '.join(f'`{n}`' for n in names)}{nothing}"
-    text = describe(hint)
+        nothing = f", or {code(off)} (none at all)" if off is not None else ""
+        listed = ", ".join(code(n) for n in names)
+        return f"a registered {cell(group.words)}: {listed}{nothing}"
+    said = describe(hint)
     bounds = implicit_bounds(key, field.metadata.get("bounds", Bounds())).describe()
-    return f"{text} {bounds}".strip()
+    return cell(f"{said} {bounds}".strip())
 
 
 def section_markdown(name: str, cls: type[Any], package: str) -> list[str]:
     """One section's heading, description and table of keys."""
     doc = inspect.cleandoc(cls.__doc__ or "")
-    lines = [f"## `[{name}]`", "", f"*Registered by package `{package}` ({cls.__module__}).*", ""]
-    lines += [doc.replace("``", "`"), ""]
+    registered = f"*Registered by package {code(package)} ({text(cls.__module__)}).*"
+    lines = [f"## {code(f'[{name}]')}", "", registered, ""]
+    lines += [text(doc.replace("``", "`")), ""]
     lines += ["| key | default | expected | unit | meaning |", "|---|---|---|---|---|"]
     hints = get_type_hints(cls)
     nested: list[tuple[str, type[Any]]] = []
@@ -45,23 +44,23 @@ def section_markdown(name: str, cls: type[Any], package: str) -> list[str]:
         item = _table_item(hint)
         if item is not None:
             nested.append((f"{name}.{field.name}", item))
-            expected = f"a list of tables (`[[{name}.{field.name}]]`, below)"
+            expected = f"a list of tables ({code(f'[[{name}.{field.name}]]')}, below)"
         else:
             expected = _expected(field.name, field, hint)
-        shown = toml_value(default) if default is not None else ""
+        shown = code(toml_value(default)) if default is not None else ""
         doc_text = field.metadata.get("doc", "")
         lines.append(
-            f"| `{field.name}` | `{_cell(shown)}` | {_cell(expected)} | {unit_of(field.name)} "
-            f"| {_cell(doc_text)} |"
+            f"| {code(field.name)} | {shown} | {expected} | {cell(key_unit(field))} "
+            f"| {cell(doc_text)} |"
         )
     profiles = getattr(cls, "PROFILES", None)
     if profiles:
         lines += ["", f"Profiles (`{name}.profile` fills these keys; keys given win):", ""]
         for profile, values in profiles.items():
-            shown = ", ".join(f"`{k} = {toml_value(v)}`" for k, v in values.items())
-            lines.append(f"- `{profile}`: {shown}")
+            shown = ", ".join(code(f"{k} = {toml_value(v)}") for k, v in values.items())
+            lines.append(f"- {code(profile)}: {shown}")
     for table_name, item in nested:
-        lines += ["", f"### `[[{table_name}]]`", ""]
+        lines += ["", f"### {code(f'[[{table_name}]]')}", ""]
         lines += section_markdown(table_name, item, package)[4:]
     lines.append("")
     return lines
@@ -80,7 +79,10 @@ def keys_markdown() -> str:
         "# Scenario keys",
         "",
         "Every key of every settings section registered by the installed packages, with its "
-        "default, what it accepts and its unit. A scenario file sets them as TOML "
+        "default, what it accepts and its unit: the one its name carries (`_m`, `_s`, "
+        "`_mps`, `_dbm`, ...), or the one declared with `param(..., unit=...)` where a "
+        "name cannot carry it; a number without a unit says what it is instead (`count`, "
+        "`probability`, `id`, ...). A scenario file sets them as TOML "
         "(`[section]` then `key = value`); `--set section.key=value` and a study's "
         "`[grid]`/`[overrides]` address them as `section.key`. An unknown section or key, a "
         "value of the wrong type or out of bounds is refused in one line naming the file, "

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from cosim.cli.plugins import plugins
 from cosim.core.registry import installed_groups
+from cosim.reference.escaping import cell, code, text
 
 
 def registries_markdown() -> str:
@@ -27,15 +28,16 @@ def registries_markdown() -> str:
     groups = installed_groups()
     for group in groups:
         lines.append(
-            f"| {group.words} | `{group.entry_points}` | {group.chosen_by} | {group.contract} |"
+            f"| {cell(group.words)} | {code(group.entry_points)} | {cell(group.chosen_by)} "
+            f"| {cell(group.contract)} |"
         )
     lines.append("")
     found = plugins(groups)
     for group in groups:
-        lines += [f"## {group.plural[0].upper()}{group.plural[1:]}", ""]
+        lines += [f"## {text(group.plural[0].upper() + group.plural[1:])}", ""]
         lines += ["| name | package | what it is |", "|---|---|---|"]
         for p in (p for p in found if p.group == group):
             said = p.summary if p.error is None else f"cannot be loaded: {p.error}"
-            lines.append(f"| `{p.name}` | `{p.package}` | {said.replace('|', '/')} |")
+            lines.append(f"| {code(p.name)} | {code(p.package)} | {cell(said)} |")
         lines.append("")
     return "\n".join(lines) + "\n"

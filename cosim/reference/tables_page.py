@@ -7,7 +7,9 @@ from dataclasses import dataclass
 from cosim.core.recorder import EVENTS, MESSAGES
 from cosim.core.registry import installed_groups
 from cosim.core.table import TableSpec
+from cosim.reference.escaping import cell, code, text
 from cosim.runner.execute import REALTIME
+from cosim.scenario.fields import unit_of
 
 
 @dataclass(frozen=True)
@@ -50,6 +52,11 @@ def documented_tables() -> list[DocumentedTable]:
     return found
 
 
+def column_unit(spec: TableSpec, column: str) -> str:
+    """A column's unit: declared in its spec's ``units``, else the one its name carries."""
+    return spec.units.get(column) or unit_of(column)
+
+
 def tables_markdown() -> str:
     """The whole table reference page."""
     lines = [
@@ -58,9 +65,11 @@ def tables_markdown() -> str:
         "A run writes its tables into `tables/NAME.parquet` of its folder (unless "
         "`record.tables = false`); `cosim.run` returns them as pandas DataFrames in "
         "`result.tables`. Units are in the column names (`t_s`, `x_m`, `yaw_rad`, "
-        "`bytes`); positions are in the `map` frame. Columns marked *category* hold "
-        "repeated strings (pandas `category`); *volatile* ones are wall-clock figures, the "
-        "only values that differ between two runs of the same scenario and seed.",
+        "`bytes`), and in a column of their own below (a count, a fraction or an id where "
+        "a number has none); positions are in the `map` frame. Columns marked *category* "
+        "hold repeated strings (pandas `category`); *volatile* ones are wall-clock "
+        "figures, the only values that differ between two runs of the same scenario and "
+        "seed.",
         "",
         "This page is generated from the tables' declarations (`TableSpec`, "
         "`cosim/reference/tables_page.py`).",
@@ -69,19 +78,20 @@ def tables_markdown() -> str:
     for table in documented_tables():
         spec = table.spec
         lines += [
-            f"## `{spec.name}`",
+            f"## {code(spec.name)}",
             "",
-            spec.doc,
+            text(spec.doc),
             "",
-            f"*Written by {table.writer}, package `{table.package}`.*",
+            f"*Written by {text(table.writer)}, package {code(table.package)}.*",
             "",
-            "| column | meaning |",
-            "|---|---|",
+            "| column | unit | meaning |",
+            "|---|---|---|",
         ]
         for column, meaning in spec.columns.items():
             marks = [m for m, on in (("category", column in spec.categorical),
                                      ("volatile", column in spec.volatile)) if on]  # fmt: skip
             note = f" *({', '.join(marks)})*" if marks else ""
-            lines.append(f"| `{column}` | {meaning.replace('|', '/')}{note} |")
+            unit = cell(column_unit(spec, column))
+            lines.append(f"| {code(column)} | {unit} | {cell(meaning)}{note} |")
         lines.append("")
     return "\n".join(lines) + "\n"

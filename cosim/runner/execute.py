@@ -351,6 +351,7 @@ REALTIME = TableSpec(
         "events": "events processed in the batch",
     },
     volatile=("lateness_ms",),
+    units={"events": "count"},
 )
 
 

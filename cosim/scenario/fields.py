@@ -68,6 +68,7 @@ def param(
     path: bool = False,
     registry: str | None = None,
     off: str | None = None,
+    unit: str | None = None,
 ) -> Any:
     """Declare a configuration field with a default, a one-line doc and numeric bounds.
 
@@ -80,6 +81,12 @@ def param(
     every element of a list) must be a name registered there; an unknown one is refused
     with the registered names. ``off`` is a value that chooses nothing (``"none"``: no
     motion-capture source at all), accepted without being registered.
+
+    ``unit`` is for a number whose name cannot carry its unit (a Nav2 name kept, such
+    as ``cost_scaling`` in ``1/m``), or that has none: it says what the number is
+    instead (``count``, ``probability``, ``ratio``, ``id``). By default a key's unit is
+    the one its name's suffix carries (:func:`unit_of`); the scenario key reference
+    shows it in a column of its own (:func:`key_unit`).
     """
     metadata = {
         "doc": doc,
@@ -87,6 +94,7 @@ def param(
         "path": path,
         "registry": registry,
         "off": off,
+        "unit": unit,
     }
     return field(default=default, metadata=metadata)
 
@@ -259,8 +267,13 @@ UNITS = {
     "_mps": "m/s",
     "_radps": "rad/s",
     "_mbps": "Mbit/s",
+    "_dbm": "dBm",
+    "_db": "dB",
+    "_wh": "Wh",
+    "_w": "W",
     "_hz": "Hz",
     "_ms": "ms",
+    "_ns": "ns",
     "_s": "s",
     "_m": "m",
     "_deg": "deg",
@@ -271,8 +284,25 @@ UNITS = {
 
 
 def unit_of(key: str) -> str:
-    """The unit a key's name carries, or an empty string."""
+    """The unit a key's name carries, or an empty string.
+
+    ``X_per_<unit>`` carries X's unit per that unit: ``drive_wh_per_m`` is in Wh/m,
+    ``cost_per_m`` in 1/m.
+    """
+    for suffix, unit in UNITS.items():
+        per = "_per" + suffix
+        if key.endswith(per) and len(key) > len(per):
+            return f"{unit_of('_' + key[: -len(per)]) or '1'}/{unit}"
     return next((unit for suffix, unit in UNITS.items() if key.endswith(suffix)), "")
+
+
+def key_unit(field: dataclasses.Field[Any]) -> str:
+    """A section key's unit: declared with ``param(..., unit=...)``, else its name's.
+
+    An empty string for a key with none (a name, a flag, a choice).
+    """
+    declared = field.metadata.get("unit")
+    return declared if isinstance(declared, str) else unit_of(field.name)
 
 
 SMALLEST = {"_hz": 1e-3, "_ms": 1e-3, "_s": 1e-6}
@@ -420,6 +450,7 @@ __all__ = [
     "field_names",
     "format_problem",
     "key_bounds",
+    "key_unit",
     "model_problem",
     "param",
     "suggest",

@@ -36,7 +36,7 @@ class ScenarioSection:
 
     name: str = param("unnamed", "name shown in summaries and folder names")
     duration_s: float = param(60.0, "simulated time to run (s)", gt=0, le=1e7)
-    seed: int = param(1, "scenario seed; every random stream derives from it", ge=0)
+    seed: int = param(1, "scenario seed; every random stream derives from it", ge=0, unit="id")
     adapters: tuple[str, ...] = param(
         (),
         "extra adapters to start, by registered name (`cosim plugins`)",
@@ -80,13 +80,15 @@ class WorldConfig:
         (2.0, 0.8), "shelf footprint [length, depth] (m)", gt=0
     )
     shelf_count: int = param(
-        24, "number of shelves (rows layouts: at most what fits)", ge=0, le=100_000
+        24, "number of shelves (rows layouts: at most what fits)", ge=0, le=100_000, unit="count"
     )
-    shelves_per_rack: int = param(3, "rows layouts: shelves end to end in one rack", ge=1)
+    shelves_per_rack: int = param(
+        3, "rows layouts: shelves end to end in one rack", ge=1, unit="count"
+    )
     aisle_width_m: float = param(1.6, "minimum free gap between shelves and walls (m)", gt=0)
     wall_thickness_m: float = param(0.2, "thickness of the outer walls (m)", gt=0, le=5.0)
     obstacles: tuple[tuple[float, float, float, float], ...] = param(
-        (), "extra obstacle boxes [[xmin_m, ymin_m, xmax_m, ymax_m], ...] in map"
+        (), "extra obstacle boxes [[xmin_m, ymin_m, xmax_m, ymax_m], ...] in map", unit="m"
     )
 
 
@@ -97,11 +99,11 @@ class RobotsConfig:
     ORDER: ClassVar[int] = 20
     """Where the section comes in a resolved scenario and in the adapters' order."""
 
-    count: int = param(4, "number of robots", gt=0, le=100_000)
+    count: int = param(4, "number of robots", gt=0, le=100_000, unit="count")
     model: Literal["jackal"] = param("jackal", "robot model")
     placement: Placement = param("dock", "start placement")
     positions: tuple[tuple[float, float, float], ...] = param(
-        (), "explicit placement: [[x_m, y_m, yaw_rad], ...] in map"
+        (), "explicit placement: [[x_m, y_m, yaw_rad], ...] in map", unit="m, m, rad"
     )
     max_speed_mps: float = param(1.0, "forward speed limit (m/s)", gt=0, le=2.0)
     max_reverse_mps: float = param(0.3, "backward speed limit (m/s)", ge=0)
@@ -142,7 +144,7 @@ class LidarConfig:
     ORDER: ClassVar[int] = 30
     """Where the section comes in a resolved scenario and in the adapters' order."""
 
-    beams: int = param(360, "beams per scan (0 disables the lidar)", ge=0, le=100_000)
+    beams: int = param(360, "beams per scan (0 disables the lidar)", ge=0, le=100_000, unit="count")
     fov_deg: float = param(
         360.0, "field of view (deg), centred on the robot's heading", gt=0, le=360
     )
@@ -173,6 +175,7 @@ class OdometryConfig:
         "error (1 sigma); 0 = perfect",
         ge=0,
         le=1,
+        unit="m/m, rad/m",
     )
 
 

@@ -9,8 +9,9 @@ controller, an adapter, a settings section, a loss model, ...) is put through, i
 - ``settings``: its settings section (the ``cosim.sections`` entry of the same name, or
   the entry itself for a section) builds from its defaults, has no problem with them, and
   every key has a one-line doc and carries the unit its doc states in its name;
-- then a short real run in a small scenario chosen for its group, and its group's
-  behaviour rules (:mod:`cosim.testing.trials`).
+- then a short real run in a small scenario chosen for its group, whose summary keys
+  must be declared (a warning otherwise), and its group's behaviour rules
+  (:mod:`cosim.testing.trials`).
 
 A check that fails stops the ones that need it (no run of a class that does not load).
 Each check yields an :class:`Outcome`, printed as one line: ``ok``, ``FAIL`` or ``skip``
@@ -36,7 +37,7 @@ from cosim.core.registry import (
     installed_groups,
     suggest_names,
 )
-from cosim.scenario.fields import UNITS, field_names, suggest, unit_of
+from cosim.scenario.fields import UNITS, field_names, key_unit, suggest
 from cosim.scenario.model import SECTIONS, section_classes, section_registry
 from cosim.testing.trials import trial_checks
 from cosim.testing.verdicts import Outcome, fail, ok, skip
@@ -180,7 +181,7 @@ def section_problems(section: type[Any]) -> list[str]:
         stated = _stated_unit(doc)
         if stated is None or not _is_number(field.default):
             continue
-        carried = unit_of(field.name)
+        carried = key_unit(field)
         if carried != stated:
             named = f"its name carries {carried}" if carried else "its name carries no unit"
             better = f"{_stem(field.name)}{UNIT_SUFFIXES[stated]}"

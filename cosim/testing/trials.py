@@ -5,7 +5,8 @@ An entry is chosen by the scenario key whose field names its group
 for an adapter), in ``warehouse-random`` made small (:data:`SMALL_WAREHOUSE`) and set up
 for what the group does: a protocol with tasks on a network that loses nothing, a
 controller with navigation, a latency model with a latency to draw. The run must finish,
-leave a flat summary, repeat exactly with the same seed, and keep its group's rules
+leave a flat summary (each key declared with its unit, or a warning), repeat exactly with
+the same seed, and keep its group's rules
 (:mod:`cosim.testing.rules`). A settings section is not run: it must survive the round
 trip through a resolved ``scenario.toml``.
 """
@@ -22,15 +23,17 @@ from typing import Any
 from cosim.core.errors import ConfigError, CosimError
 from cosim.core.plugins import plugin_of_module
 from cosim.core.registry import Group
+from cosim.core.summary import declaration_problems, summary_keys_of
 from cosim.runner.assembly import check_scenario
 from cosim.runner.execute import run
 from cosim.runner.result import RECORD_KEYS, RunResult
+from cosim.runner.summary_keys import declared_keys
 from cosim.scenario import Scenario, dump_scenario, load_scenario, scenario_from_text
 from cosim.scenario.model import SECTIONS, section_classes
 from cosim.testing.outcomes import assert_same_run
 from cosim.testing.rules import Rule, assigns, conflicts, delivers, finite, moves, tracks
 from cosim.testing.running import SMALL_WAREHOUSE
-from cosim.testing.verdicts import Outcome, fail, ok, skip
+from cosim.testing.verdicts import Outcome, fail, ok, skip, warn
 
 PRESET = "warehouse-random"
 """The preset every trial starts from (with :data:`SMALL_WAREHOUSE`)."""
@@ -138,6 +141,7 @@ def trial_checks(
         f"{seconds:g} s simulated in {first.summary['wall_time_s']:.3g} s of wall-clock time",
     )
     yield flat_summary(first)
+    yield declared_summary(first, name, entry)
     second = try_run(scenario, seconds)
     if isinstance(second, Outcome):
         yield fail("repeats", f"the second run with the same seed failed: {second.detail}")
@@ -205,6 +209,36 @@ def flat_summary(result: RunResult) -> Outcome:
     except (TypeError, ValueError) as error:
         return fail("summary", f"summary.json cannot be written: {error}")
     return ok("summary", f"{len(result.summary)} flat entries")
+
+
+def declared_summary(result: RunResult, name: str, entry: Any) -> Outcome:
+    """Every key of ``summary.json`` is declared with its unit and meaning.
+
+    Each writer declares its keys in a ``summary_keys`` class attribute (key ->
+    :class:`~cosim.core.summary.SummaryKey`), from which the summary reference is
+    generated. A key the run wrote that nothing installed (nor the entry) declares is a
+    warning: the reference cannot document it, but nothing breaks. A declaration that is
+    no mapping of keys to a ``SummaryKey`` with a unit and a one-line doc fails.
+    """
+    problems = declaration_problems(entry)
+    if problems:
+        return fail("declared", f"{name}: " + "; ".join(problems))
+    declared = declared_keys(entry)
+    missing = [key for key in result.summary if key not in declared]
+    if missing:
+        listed = ", ".join(missing)
+        return warn(
+            "declared",
+            f"summary key{'s' * (len(missing) > 1)} {listed} declared nowhere: declare each "
+            "in the summary_keys of the class that writes it (key -> "
+            "cosim.core.summary.SummaryKey(unit, doc)), so the summary reference documents it",
+        )
+    own = len(summary_keys_of(entry))
+    mine = f", {own} of them by {name}" if own else ""
+    return ok(
+        "declared",
+        f"the {len(result.summary)} summary keys are declared with unit and meaning{mine}",
+    )
 
 
 def round_trip(name: str, overrides: Mapping[str, Any]) -> Outcome:

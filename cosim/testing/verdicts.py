@@ -1,4 +1,4 @@
-"""How one check of ``cosim check-plugin`` came out: ok, FAIL or skip, and why, in one line."""
+"""How one check of ``cosim check-plugin`` came out: ok, warn, FAIL or skip, and why."""
 
 from __future__ import annotations
 
@@ -10,6 +10,7 @@ class Verdict(Enum):
     """How a check came out."""
 
     OK = "ok"
+    WARN = "warn"
     FAIL = "FAIL"
     SKIP = "skip"
 
@@ -20,7 +21,8 @@ class Outcome:
 
     Attributes:
         check: the check's name (``contract``, ``runs``, ``assigns``).
-        verdict: ok, FAIL or skip.
+        verdict: ok, warn (passed, with something to fix that breaks nothing), FAIL
+            or skip.
         detail: what was found (for ok), why it failed, or why it was skipped: one line.
     """
 
@@ -41,6 +43,11 @@ class Outcome:
 def ok(check: str, detail: str) -> Outcome:
     """A passed check."""
     return Outcome(check, Verdict.OK, detail)
+
+
+def warn(check: str, why: str) -> Outcome:
+    """A passed check that found something to fix (it breaks nothing)."""
+    return Outcome(check, Verdict.WARN, why)
 
 
 def fail(check: str, why: str) -> Outcome:

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 
+from cosim.runner.summary_keys import declared_keys
 from tests.conftest import REPO, cosim_main
 
 pytestmark = pytest.mark.slow
@@ -37,6 +38,7 @@ def test_the_site_has_every_page_of_the_navigation(site):
         "tutorials/write-a-protocol.html",
         "reference/scenario-keys.html",
         "reference/tables.html",
+        "reference/summary.html",
         "reference/cli.html",
         "reference/api.html",
         "reference/registries.html",
@@ -55,3 +57,15 @@ def test_the_api_reference_renders_the_run_function_and_the_contracts(site):
     html = (site / "reference" / "api.html").read_text()
     for name in ("cosim.run", "RunContext", "ProtocolFleet", "ControlInputs", "TableSpec"):
         assert name in html, name
+
+
+def test_names_in_angle_brackets_units_and_every_summary_key_are_in_the_built_site(site):
+    keys = (site / "reference" / "scenario-keys.html").read_text()
+    assert "Twist on /&lt;robot&gt;/cmd_vel" in keys
+    assert "publishes /vicon/&lt;subject&gt;/&lt;segment&gt;)" in keys
+    assert "<td>dBm</td>" in keys and "<td>dB</td>" in keys and "<td>1/m</td>" in keys
+    registries = (site / "reference" / "registries.html").read_text()
+    assert "a Unity scene's /&lt;robot&gt;/cmd_vel" in registries
+    summary = (site / "reference" / "summary.html").read_text()
+    for key in declared_keys():
+        assert f"<td><code>{key}</code></td>" in summary, key

@@ -27,7 +27,11 @@ class AuctionSettings:
     """``[sequential_auction]``: how robots settle their bids and auction the tasks."""
 
     settle_rounds: int = param(
-        1, "rounds without news, beyond the network's diameter, before auctioning", ge=0, le=100
+        1,
+        "rounds without news, beyond the network's diameter, before auctioning",
+        ge=0,
+        le=100,
+        unit="rounds",
     )
     order: Literal["task_id", "cheapest_first"] = param(
         "task_id", "auction order: the tasks in id order, or the cheapest bid first"

@@ -19,7 +19,9 @@ from models.network.loss import LossProcess
 class EveryNthSettings:
     """``[every_nth]``: the loss model ``network.loss_model = "every_nth"``."""
 
-    n: int = param(10, "every n-th message of each directed link is lost", ge=2, le=1_000_000)
+    n: int = param(
+        10, "every n-th message of each directed link is lost", ge=2, le=1_000_000, unit="count"
+    )
 
 
 class EveryNthLoss:

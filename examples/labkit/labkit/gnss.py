@@ -17,6 +17,7 @@ from adapters.mocap.contract import SourceContext, Tracked
 from adapters.mocap.settings import MocapConfig
 from cosim.core.adapter import RunContext
 from cosim.core.kernel import Stage
+from cosim.core.summary import SummaryKey
 from cosim.core.timebase import period_ns
 from cosim.scenario.fields import param
 from models.fleet.kinematics import FleetState
@@ -35,6 +36,9 @@ class GnssSource:
     """An RTK GNSS fix of every robot (see the module)."""
 
     name: ClassVar[str] = "gnss"
+    summary_keys: ClassVar[Mapping[str, SummaryKey]] = {
+        "gnss_fixes": SummaryKey("count", "position fixes taken, every robot's"),
+    }
     external: ClassVar[bool] = False
     live: ClassVar[bool] = False
     uses_dds: ClassVar[bool] = False

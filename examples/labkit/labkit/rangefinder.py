@@ -21,6 +21,7 @@ from cosim.core.bus import TopicQos
 from cosim.core.hosts import HostId
 from cosim.core.kernel import Stage
 from cosim.core.messages import Const, Message, ros_message, std
+from cosim.core.summary import SummaryKey
 from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns
 from cosim.scenario.fields import param
@@ -50,7 +51,7 @@ class RangeFinderSettings:
 
     rate_hz: float = param(10.0, "readings per second (Hz)", gt=0, le=1000)
     fov_deg: float = param(15.0, "width of the sensing cone (deg)", gt=0, le=90)
-    rays: int = param(5, "rays cast across the cone", ge=1, le=100)
+    rays: int = param(5, "rays cast across the cone", ge=1, le=100, unit="count")
     range_min_m: float = param(0.02, "nearest reading (m)", ge=0)
     range_max_m: float = param(4.0, "farthest reading (m)", gt=0, le=100)
 
@@ -84,6 +85,12 @@ class RangeFinderAdapter:
     name: ClassVar[str] = "rangefinder"
     requires: ClassVar[tuple[str, ...]] = ("world", "fleet")
     tables: ClassVar[tuple[TableSpec, ...]] = (RANGES,)
+    summary_keys: ClassVar[Mapping[str, SummaryKey]] = {
+        "rangefinder_readings": SummaryKey("count", "readings taken, every robot's"),
+        "rangefinder_closest_m": SummaryKey(
+            "m", "closest thing any robot saw ahead (null: nothing in range)"
+        ),
+    }
 
     def __init__(self, run: RunContext) -> None:
         self.settings = run.settings(RangeFinderSettings)

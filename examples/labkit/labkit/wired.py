@@ -18,6 +18,7 @@ from adapters.network.contract import NetworkContext
 from cosim.core.adapter import RunContext
 from cosim.core.hosts import HostId
 from cosim.core.link import DELIVERED, AllDelivered, Transfer
+from cosim.core.summary import SummaryKey
 from cosim.core.table import TableSpec
 from cosim.core.timebase import ms_to_ns
 from cosim.scenario.fields import Problem, param
@@ -42,6 +43,9 @@ class WiredBackend:
 
     name: ClassVar[str] = "wired"
     tables: ClassVar[tuple[TableSpec, ...]] = ()
+    summary_keys: ClassVar[Mapping[str, SummaryKey]] = {
+        "wired_copies": SummaryKey("count", "message copies that crossed the switch"),
+    }
 
     def __init__(self, context: NetworkContext) -> None:
         settings = context.run.settings(WiredSettings)

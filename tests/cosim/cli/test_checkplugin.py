@@ -6,12 +6,14 @@ import os
 import re
 import subprocess
 import sys
+from collections.abc import Mapping
 from pathlib import Path
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import pytest
 
 from adapters.assignment.contract import EpochView, ProtocolBase
+from cosim.core.adapter import RunContext
 from cosim.core.registry import installed_groups, registered
 from cosim.testing.checks import registry_of
 from tests.conftest import REPO, cosim_main
@@ -103,7 +105,34 @@ def test_a_protocol_that_assigns_nobody_fails_naming_the_check_and_exits_3():
         "given in code)"
     )
     assert "FAIL assigns: no task of 3 claimed within 5 s of appearing" in done.stdout
-    assert lines[-1] == "nobody: 1 of 9 checks failed: assigns"
+    assert lines[-1] == "nobody: 1 of 10 checks failed: assigns"
+
+
+class Undeclared:
+    """A user's adapter whose summary key is declared nowhere."""
+
+    name: ClassVar[str] = "undeclared"
+    requires: ClassVar[tuple[str, ...]] = ()
+
+    def __init__(self, run: RunContext) -> None: ...
+
+    def start(self, run: RunContext) -> None: ...
+
+    def finish(self, run: RunContext) -> Mapping[str, Any]:
+        return {"undeclared_count": 1}
+
+
+def test_a_summary_key_declared_nowhere_is_a_warning_and_the_plugin_passes():
+    with registered("cosim.adapters", "undeclared", Undeclared):
+        done = cosim_main("check-plugin", "undeclared")
+    assert done.returncode == 0, done.stdout + done.stderr
+    lines = done.stdout.splitlines()
+    assert [line for line in lines if line.startswith("warn")] == [
+        "warn declared: summary key undeclared_count declared nowhere: declare each in the "
+        "summary_keys of the class that writes it (key -> cosim.core.summary.SummaryKey(unit, "
+        "doc)), so the summary reference documents it"
+    ]
+    assert re.fullmatch(r"undeclared: \d+ checks passed \(1 with a warning\), 1 skipped", lines[-1])
 
 
 BROKEN = {

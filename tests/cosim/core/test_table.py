@@ -155,3 +155,9 @@ def test_a_table_spec_is_immutable_with_no_categorical_or_volatile_columns_by_de
     assert list(spec.columns) == ["t_s", "x_m"]
     with pytest.raises(dataclasses.FrozenInstanceError):
         spec.name = "other"  # type: ignore[misc]
+
+
+def test_a_table_spec_declares_the_units_its_column_names_cannot_carry():
+    spec = TableSpec("t", "one row", {"t_s": "when (s)", "bytes": "size"}, units={"bytes": "bytes"})
+    assert spec.units == {"bytes": "bytes"}
+    assert TableSpec("t", "one row", {"t_s": "when (s)"}).units == {}

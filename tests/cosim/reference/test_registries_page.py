@@ -8,6 +8,7 @@ from cosim.cli.plugins import plugins
 from cosim.core.registry import Plugin, installed_groups
 from cosim.reference import registries_page
 from cosim.reference.registries_page import registries_markdown
+from tests.cosim.reference.rendered import rows
 
 
 def test_the_registry_reference_lists_every_registry_and_built_in():
@@ -44,4 +45,11 @@ def test_a_plugin_that_cannot_be_loaded_is_listed_with_its_error(monkeypatch):
     broken = Plugin(group, "auction", "labkit", "labkit.x:Auction", "", "No module named 'x' | y")
     monkeypatch.setattr(registries_page, "plugins", lambda groups: [broken])
     page = registries_markdown()
-    assert "| `auction` | `labkit` | cannot be loaded: No module named 'x' / y |" in page
+    assert "| `auction` | `labkit` | cannot be loaded: No module named 'x' \\| y |" in page
+    assert ["auction", "labkit", "cannot be loaded: No module named 'x' | y"] in rows(page)
+
+
+def test_a_summary_naming_a_topic_in_angle_brackets_shows_it():
+    page = registries_markdown()
+    teleop = [row for row in rows(page) if row[0] == "teleop" and "operator" in row[2]]
+    assert teleop and "a Unity scene's /<robot>/cmd_vel" in teleop[-1][2]

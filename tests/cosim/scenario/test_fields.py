@@ -24,6 +24,7 @@ from cosim.scenario.fields import (
     format_problem,
     implicit_bounds,
     key_bounds,
+    key_unit,
     model_problem,
     param,
     show_name,
@@ -197,6 +198,29 @@ def test_a_param_carries_its_doc_bounds_path_registry_and_off_value():
     assert found["source"].metadata["off"] == "none"
     assert docs(Gadget)["rate_hz"] == "ticks per second (Hz)"
     assert field_names(Gadget)[:3] == ["count", "rate_hz", "wait_s"]
+
+
+@dataclass(frozen=True)
+class Radio:
+    tx_power_dbm: float = param(20.0, "transmit power (dBm)")
+    shadowing_db: float = param(4.0, "shadowing deviation (dB)")
+    cost_scaling: float = param(3.0, "inflation slope (1/m)", unit="1/m")
+    beams: int = param(360, "beams per scan", unit="count")
+    rate_hz: float = param(5.0, "ticks per second (Hz)", unit="ticks/s")
+    name: str = param("a", "a name")
+
+
+def test_a_key_s_unit_is_the_declared_one_else_the_one_its_name_carries():
+    units = {f.name: key_unit(f) for f in dataclasses.fields(Radio)}
+    assert units == {
+        "tx_power_dbm": "dBm",
+        "shadowing_db": "dB",
+        "cost_scaling": "1/m",
+        "beams": "count",
+        "rate_hz": "ticks/s",  # declared wins over the name's
+        "name": "",
+    }
+    assert dataclasses.fields(Radio)[0].metadata["unit"] is None
 
 
 def test_a_problem_message_is_one_line_with_the_value_shown_as_toml():

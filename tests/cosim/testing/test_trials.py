@@ -14,6 +14,7 @@ from adapters.assignment.contract import PROTOCOLS, EpochView, ProtocolBase
 from adapters.mocap.contract import MOCAP_SOURCES
 from adapters.navigation.contract import CONTROLLERS
 from cosim.core.registry import ADAPTERS, Group, registered
+from cosim.core.summary import SummaryKey
 from cosim.scenario.fields import param
 from cosim.scenario.model import SECTIONS
 from cosim.testing.trials import choosing_key, raised, trial_checks
@@ -43,10 +44,10 @@ class Nobody(ProtocolBase):
 def test_a_protocol_that_assigns_nobody_fails_assigns_naming_every_task():
     said = lines(PROTOCOLS, "nobody", Nobody)
     assert [line.split(":")[0] for line in said] == [
-        "ok   scenario", "ok   runs", "ok   summary", "ok   repeats", "FAIL assigns",
-        "ok   conflicts",
+        "ok   scenario", "ok   runs", "ok   summary", "ok   declared", "ok   repeats",
+        "FAIL assigns", "ok   conflicts",
     ]  # fmt: skip
-    assert said[4] == (
+    assert said[5] == (
         "FAIL assigns: 3 of 3 tasks not claimed within 5 s of appearing: task 0 (appeared at "
         "0 s, never claimed by the end at 15 s); task 1 (appeared at 0 s, never claimed by "
         "the end at 15 s); task 2 (appeared at 0 s, never claimed by the end at 15 s) (on a "
@@ -65,8 +66,8 @@ class Idle(ProtocolBase):
 
 def test_robots_deciding_alone_on_nothing_fail_even_the_lesser_rule():
     said = lines(PROTOCOLS, "idle", Idle)
-    assert "FAIL assigns: no task of 3 claimed within 5 s of appearing" in said[4]
-    assert said[5].startswith("skip conflicts: 0 allowed: it exchanges no messages")
+    assert "FAIL assigns: no task of 3 claimed within 5 s of appearing" in said[5]
+    assert said[6].startswith("skip conflicts: 0 allowed: it exchanges no messages")
 
 
 class NanControl:
@@ -196,6 +197,65 @@ def test_a_summary_entry_that_is_not_flat_fails_summary():
     said = lines(ADAPTERS, "nested", Nested)
     assert "FAIL summary: summary entries that are no number, string, true/false or null: " \
            "nested_counts = {'a': 1}" in said  # fmt: skip
+
+
+def _gadget(keys: object) -> type:
+    """An adapter writing ``gadget_fixes`` that declares ``keys`` (none: declares nothing)."""
+
+    class Gadget:
+        name: ClassVar[str] = "gadget"
+        requires: ClassVar[tuple[str, ...]] = ()
+
+        def __init__(self, run: Any) -> None: ...
+
+        def start(self, run: Any) -> None: ...
+
+        def finish(self, run: Any) -> Mapping[str, Any]:
+            return {"gadget_fixes": 3, "gadget_closest_m": 0.5}
+
+    if keys is not None:
+        Gadget.summary_keys = keys  # type: ignore[attr-defined]
+    return Gadget
+
+
+def _declared(said: list[str]) -> str:
+    return next(line for line in said if line.split(":")[0].split()[-1] == "declared")
+
+
+def test_summary_keys_a_plugin_declares_nowhere_are_a_warning_naming_them_and_how():
+    said = lines(ADAPTERS, "gadget", _gadget(None))
+    assert _declared(said) == (
+        "warn declared: summary keys gadget_fixes, gadget_closest_m declared nowhere: declare "
+        "each in the summary_keys of the class that writes it (key -> "
+        "cosim.core.summary.SummaryKey(unit, doc)), so the summary reference documents it"
+    )
+    assert not any(line.startswith("FAIL") for line in said)
+    one = {"gadget_fixes": SummaryKey("count", "fixes taken")}
+    assert _declared(lines(ADAPTERS, "gadget", _gadget(one))).startswith(
+        "warn declared: summary key gadget_closest_m declared nowhere: "
+    )
+
+
+def test_a_plugin_declaring_its_summary_keys_passes_the_check():
+    keys = {
+        "gadget_fixes": SummaryKey("count", "fixes taken"),
+        "gadget_closest_m": SummaryKey("m", "closest thing seen"),
+    }
+    found = _declared(lines(ADAPTERS, "gadget", _gadget(keys)))
+    assert re.fullmatch(
+        r"ok   declared: the \d+ summary keys are declared with unit and meaning, 2 of them by "
+        r"gadget",
+        found,
+    )
+
+
+def test_a_declaration_without_a_unit_or_no_summary_key_fails():
+    keys = {"gadget_fixes": SummaryKey("", "fixes taken"), "gadget_closest_m": ("m", "closest")}
+    assert _declared(lines(ADAPTERS, "gadget", _gadget(keys))) == (
+        "FAIL declared: gadget: summary_keys['gadget_fixes'] has no unit: give one (s, m, "
+        "bytes, ...), or say what a unitless value is (count, fraction, ratio, true/false, "
+        "text); summary_keys['gadget_closest_m'] is a tuple; expected a SummaryKey"
+    )
 
 
 def test_a_run_that_ended_early_keeping_what_ran_fails_runs(monkeypatch):
