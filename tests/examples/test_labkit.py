@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 from importlib.metadata import version
@@ -29,11 +30,17 @@ SHORT = ["--duration-s", "30", "--set", "robots.driver=tasks"]
 
 @pytest.fixture(scope="module")
 def plugins(tmp_path_factory: pytest.TempPathFactory) -> dict[str, str]:
-    """An environment with labkit installed (a folder on PYTHONPATH)."""
+    """An environment with labkit installed (a folder on PYTHONPATH).
+
+    Built from a copy: pip builds inside the source folder (``build/``, ``*.egg-info``), and
+    two test workers installing from the same folder at once broke each other's build.
+    """
     target = tmp_path_factory.mktemp("site")
+    source = tmp_path_factory.mktemp("src") / "labkit"
+    shutil.copytree(LABKIT, source, ignore=shutil.ignore_patterns("build", "*.egg-info"))
     subprocess.run(
         [sys.executable, "-m", "pip", "install", "--quiet", "--no-deps", "--no-build-isolation",
-         "--target", str(target), str(LABKIT)],
+         "--target", str(target), str(source)],
         check=True, capture_output=True, timeout=300,
     )  # fmt: skip
     return {**os.environ, "PYTHONPATH": os.pathsep.join([str(target), str(REPO)])}
