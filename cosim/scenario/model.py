@@ -19,6 +19,7 @@ from typing import Any, TypeVar
 
 from cosim.core.errors import ConfigError, RegistryError
 from cosim.core.registry import Group, Registry
+from cosim.scenario.arguments import seed_argument
 from cosim.scenario.fields import key_bounds
 from cosim.scenario.provenance import PROVENANCE
 from cosim.scenario.sections import (
@@ -195,8 +196,14 @@ class Scenario:
         return Scenario({**self.sections, name: section}, self.source, self.resolved_with)
 
     def with_seed(self, seed: int) -> Scenario:
-        """Return a copy with another seed."""
-        return self.with_section("scenario", replace(self.scenario, seed=seed))
+        """Return a copy with another seed.
+
+        Raises:
+            ArgumentError: a seed that is no int (a bool, a string); ConfigError: a
+                negative one (:func:`cosim.scenario.arguments.seed_argument`).
+        """
+        checked = seed_argument("Scenario.with_seed", seed)
+        return self.with_section("scenario", replace(self.scenario, seed=checked))
 
     def with_duration(self, duration_s: float) -> Scenario:
         """Return a copy with another duration (s), within the bounds of ``scenario.duration_s``.

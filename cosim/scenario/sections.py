@@ -30,7 +30,11 @@ class ScenarioSection:
     ORDER: ClassVar[int] = 0
     """Where the section comes in a resolved scenario and in the adapters' order."""
 
-    name: str = param("unnamed", "name shown in summaries and folder names")
+    name: str = param(
+        "unnamed",
+        "name shown in summaries and folder names: letters and digits of any script, spaces "
+        "between words, '_', '-', '.', '+'",
+    )
     duration_s: float = param(60.0, "simulated time to run (s)", gt=0, le=1e7)
     seed: int = param(1, "scenario seed; every random stream derives from it", ge=0)
     adapters: tuple[str, ...] = param(
