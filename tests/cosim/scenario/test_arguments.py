@@ -175,3 +175,23 @@ def test_cosim_study_names_a_wrong_argument_before_reading_the_study(tmp_path, k
 def test_cosim_study_names_a_study_file_that_is_no_path(tmp_path, path):
     with pytest.raises(ArgumentError, match=r"^cosim.study\(path=.*\): expected a study file"):
         cosim.study(path, tmp_path / "out")
+
+
+def test_a_section_asked_for_by_name_instead_of_class_says_how_to_read_it_by_name():
+    scenario = cosim.load_scenario("warehouse-random")
+    with pytest.raises(ArgumentError) as caught:
+        scenario.section("navigation")  # type: ignore[arg-type]
+    assert str(caught.value) == (
+        "Scenario.section(kind='navigation'): expected a settings class (NavigationConfig); "
+        "by name: scenario.sections[name]"
+    )
+
+
+@pytest.mark.parametrize(
+    ("name", "section", "argument"),
+    [(3, None, "name"), ("robots", {"count": 9}, "section"), ("robots", int, "section")],
+)
+def test_with_section_takes_a_name_and_a_settings_instance(name, section, argument):
+    scenario = cosim.load_scenario("warehouse-random")
+    with pytest.raises(ArgumentError, match=rf"^Scenario.with_section\({argument}="):
+        scenario.with_section(name, section)
