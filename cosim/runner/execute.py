@@ -403,9 +403,6 @@ def run(
     result.tables["poses"].groupby("robot").v_mps.mean()
     ```
 
-    Every argument is checked first (:mod:`cosim.runner.arguments`): one of the wrong type
-    is refused in one line naming it, its value and what was expected.
-
     Args:
         scenario: from :func:`cosim.load_scenario`; or a preset name or a scenario file,
             loaded as ``cosim.load_scenario(scenario)`` would.
@@ -435,7 +432,8 @@ def run(
         ``compile_time_s``).
 
     Raises:
-        ArgumentError: (a ``ConfigError`` and a ``TypeError``) an argument of the wrong type.
+        ArgumentError: (a ``ConfigError`` and a ``TypeError``) an argument of the wrong type,
+            in one line naming it (:mod:`cosim.runner.arguments` checks them all first).
         ConfigError: an argument out of bounds (``seed=-1``), or a scenario given by name or
             file that does not load.
         RunStopped: the run was asked to stop (``stop``).
