@@ -33,8 +33,10 @@ if TYPE_CHECKING:
     from cosim.runner.execute import run
     from cosim.runner.result import RunResult
     from cosim.scenario import Scenario, load_scenario
+    from cosim.scenario.arguments import ArgumentError
 
 _DEFINED_IN = {
+    "ArgumentError": "cosim.scenario.arguments",
     "BridgeError": "cosim.core.errors",
     "ConfigError": "cosim.core.errors",
     "CosimError": "cosim.core.errors",
@@ -85,16 +87,56 @@ def study(
         workers: local processes (default: the machine's cores).
         scheduler: a Dask scheduler address to run on instead (``tcp://host:port``).
         resume: continue a study in ``out``.
-        **options: passed to :func:`cosim.studies.run_study` (``progress``, ``report``).
+        **options: passed to :func:`cosim.studies.run_study` (``progress``, ``report``,
+            ``notify``, ``scheduler_timeout_s``).
+
+    Raises:
+        ArgumentError: (a ``ConfigError`` and a ``TypeError``) an argument of the wrong
+            type, or a keyword the call does not take; one line naming it.
+        ConfigError: an invalid study file, or an argument out of bounds (``workers=0``).
     """
+    from cosim.scenario import arguments as check
     from cosim.studies import load_study, run_study
 
+    call = "cosim.study"
+    study_file = check.path_argument(call, "path", path, what="a study file")
+    folder = check.path_argument(call, "out", out, what="a study folder")
+    workers = check.count_argument(call, "workers", workers)
+    if scheduler is not None:
+        check.text_argument(call, "scheduler", scheduler)
+    resume = check.flag_argument(call, "resume", resume)
+    check.keywords_argument(call, options, STUDY_OPTIONS)
+    for name, value in options.items():
+        if name == "report":
+            check.flag_argument(call, name, value)
+        elif name == "progress" and value is not None and not callable(getattr(value, "begin", 0)):
+            raise check.wrong_type(call, name, value, STUDY_OPTIONS[name] + ", or None")
+        elif name == "scheduler_timeout_s":
+            check.positive_argument(call, name, value, "seconds")
+        else:
+            check.callable_argument(call, name, value, STUDY_OPTIONS[name], arity=1)
     return run_study(
-        load_study(path), out, workers=workers, scheduler=scheduler, resume=resume, **options
+        load_study(study_file),
+        folder,
+        workers=workers,
+        scheduler=scheduler,
+        resume=resume,
+        **options,
     )
 
 
+STUDY_OPTIONS = {
+    "progress": "a StudyProgress (cosim.studies.progress): its begin(total, done), then a "
+    "call after every run",
+    "report": "True or False: write the report of a study with a [report] section",
+    "notify": "a function of one line: what resuming found",
+    "scheduler_timeout_s": "how long to wait for the Dask scheduler (s)",
+}
+"""The keyword options :func:`study` passes on to :func:`cosim.studies.run_study`."""
+
+
 __all__ = [
+    "ArgumentError",
     "BridgeError",
     "ConfigError",
     "CosimError",

@@ -26,6 +26,7 @@ from adapters.fleet.robots_layer import RobotsLayer
 from adapters.fleet.topics import odom_topic
 from adapters.mapping.contract import MAP_SHARING, MapSharing, SharingContext
 from adapters.mapping.geometry import map_geometry
+from adapters.mapping.memory import check_mapping_memory
 from adapters.mapping.settings import MappingConfig
 from adapters.mapping.tables import (
     MAP_MERGES,
@@ -51,6 +52,7 @@ from cosim.core.messages import (
 from cosim.core.summary import SummaryKey
 from cosim.core.table import TableSpec
 from cosim.core.timebase import period_ns
+from cosim.scenario.model import Scenario
 from cosim.scenario.sections import LidarConfig
 from models.arrays import FloatArray
 from models.fleet.kinematics import FleetState
@@ -118,6 +120,14 @@ class MappingAdapter:
         ),
     }
     """The summary keys :meth:`finish` writes (documented in the summary reference)."""
+
+    @staticmethod
+    def check_scenario(scenario: Scenario) -> None:
+        """Refuse a ``mapping.resolution_m`` whose maps would not fit in memory.
+
+        See :mod:`adapters.mapping.memory`.
+        """
+        check_mapping_memory(scenario)
 
     def __init__(self, run: RunContext) -> None:
         self.cfg = run.settings(MappingConfig)

@@ -34,6 +34,7 @@ from adapters.navigation.contract import (
     traffic_registry,
 )
 from adapters.navigation.fleet_traffic import FleetTraffic
+from adapters.navigation.memory import check_navigation_memory
 from adapters.navigation.parts import build_parts
 from adapters.navigation.settings import NavigationConfig
 from adapters.navigation.tables import NAV_SUMMARY, NAVIGATION
@@ -79,10 +80,11 @@ class NavigationAdapter:
 
     @staticmethod
     def check_scenario(scenario: Scenario) -> None:
-        """Names known, and what the chosen traffic policy refuses (before anything is built).
+        """Names known, what the chosen traffic policy refuses, and costmaps that fit in memory.
 
         A policy may declare ``check_scenario(scenario)``: the fleet manager refuses robots
-        that cannot localize well enough for its places.
+        that cannot localize well enough for its places. A ``resolution_m`` whose costmaps
+        would not fit in memory is refused (:mod:`adapters.navigation.memory`).
         """
         cfg = scenario.section(NavigationConfig)
         controller_registry().get(cfg.controller)
@@ -90,6 +92,7 @@ class NavigationAdapter:
         check = getattr(traffic_registry().get(cfg.traffic), "check_scenario", None)
         if check is not None:
             check(scenario)
+        check_navigation_memory(scenario)
 
     def __init__(self, run: RunContext) -> None:
         self.cfg = run.settings(NavigationConfig)

@@ -24,6 +24,7 @@ from cosim.core.timebase import NS_PER_S, s_to_ns
 from cosim.recording.dataframes import run_frames
 from cosim.recording.foxglove import LiveOptions
 from cosim.recording.setup import RecordingPlan, RecordingSession
+from cosim.runner.arguments import run_arguments
 from cosim.runner.assembly import Assembly, assemble
 from cosim.runner.compiletime import CompileClock
 from cosim.runner.faults import (
@@ -380,7 +381,7 @@ def record_lateness(lateness: Lateness, recorder: Recorder) -> dict[str, Any]:
 
 
 def run(
-    scenario: Scenario,
+    scenario: Scenario | str | Path,
     *,
     seed: int | None = None,
     duration_s: float | None = None,
@@ -404,8 +405,9 @@ def run(
     ```
 
     Args:
-        scenario: from :func:`cosim.load_scenario`.
-        seed: overrides ``scenario.seed``.
+        scenario: from :func:`cosim.load_scenario`; or a preset name or a scenario file,
+            loaded as ``cosim.load_scenario(scenario)`` would.
+        seed: overrides ``scenario.seed`` (an int >= 0; not a bool).
         duration_s: overrides ``scenario.duration_s`` (s).
         out: folder to write (``summary.json``, ``scenario.toml``, ``tables/``, ``bag/``).
         force: replace the results in a non-empty ``out``.
@@ -416,7 +418,8 @@ def run(
         on_ready: called once the recording is set up, before the run starts.
         adapters: more adapters to run: registered names, or adapter classes (a class is
             used for this run as if registered under its ``name``; the resolved
-            ``scenario.toml`` cannot name it, so ``cosim run`` of that file runs without it).
+            ``scenario.toml`` cannot name it, so ``cosim run`` of that file runs without it);
+            one name or class alone is taken as a list of one.
         stop: a stop request (:func:`cosim.runner.stopping.stop_on_signals`): a run asked
             to stop ends at an event boundary, and what ran is kept (the bag finished, the
             tables and a summary marked ``"stopped"`` written) before
@@ -430,6 +433,10 @@ def run(
         ``compile_time_s``).
 
     Raises:
+        ArgumentError: (a ``ConfigError`` and a ``TypeError``) an argument of the wrong type,
+            in one line naming it (:mod:`cosim.runner.arguments` checks them all first).
+        ConfigError: an argument out of bounds (``seed=-1``), or a scenario given by name or
+            file that does not load.
         RunStopped: the run was asked to stop (``stop``).
         BridgeError: an external system failed mid-run; with ``out``, what ran is written
             there first and the message says where.
@@ -438,11 +445,21 @@ def run(
             ``BridgeError``, with the traceback in ``out/failure.txt``.
         InternalError: cosim's own code failed mid-run (a bug); likewise.
     """
-    if seed is not None:
-        scenario = scenario.with_seed(seed)
-    if duration_s is not None:
-        scenario = scenario.with_duration(duration_s)
-    folder = Path(out) if out is not None else None
+    checked = run_arguments(
+        scenario,
+        seed=seed,
+        duration_s=duration_s,
+        out=out,
+        force=force,
+        progress=progress,
+        live=live,
+        on_ready=on_ready,
+        adapters=adapters,
+        stop=stop,
+        figures=figures,
+        unity=unity,
+    )
+    scenario, folder = checked.scenario, checked.out
     with _deferred(stop):
         try:
             result = execute(
@@ -452,7 +469,7 @@ def run(
                 force=force,
                 live=live,
                 on_ready=on_ready,
-                adapters=adapters,
+                adapters=checked.adapters,
                 stop=stop,
                 figures=figures,
                 unity=unity,

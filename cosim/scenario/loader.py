@@ -16,6 +16,12 @@ from pathlib import Path
 from typing import Any
 
 from cosim.core.errors import ConfigError, RegistryError
+from cosim.scenario.arguments import (
+    origins_argument,
+    overrides_argument,
+    path_argument,
+    text_argument,
+)
 from cosim.scenario.extends import resolve as resolve_extends
 from cosim.scenario.fields import build, show_name, show_value, suggest
 from cosim.scenario.model import Scenario, section_classes, section_registry
@@ -122,7 +128,15 @@ def load_scenario(
     Raises:
         ConfigError: for a missing file, malformed TOML, an unknown section or key, or a
             value of the wrong type or out of bounds; the message names all of them.
+        ArgumentError: (a ``ConfigError`` and a ``TypeError``) for an argument of the
+            wrong type: ``overrides`` that are no mapping, a ``spec`` that is no str or path.
     """
+    call = "cosim.load_scenario"
+    path = path_argument(call, "spec", spec, what="a preset name or a scenario file")
+    spec = spec if isinstance(spec, str) else path  # a str may name a preset, a Path not
+    overrides = overrides_argument(call, overrides)
+    override_origin = text_argument(call, "override_origin", override_origin)
+    override_origins = origins_argument(call, override_origins)
     origin, raw = _read_source(spec)
     layers = resolve_extends(origin, copy.deepcopy(raw), read=_read_source, presets=preset_names)
     raw, origins = layers.raw, dict(layers.keys)

@@ -19,6 +19,7 @@ from typing import Any, TypeVar
 
 from cosim.core.errors import ConfigError, RegistryError
 from cosim.core.registry import Group, Registry
+from cosim.scenario.arguments import seed_argument, text_argument, wrong_type
 from cosim.scenario.fields import key_bounds
 from cosim.scenario.provenance import PROVENANCE
 from cosim.scenario.sections import (
@@ -112,7 +113,16 @@ class Scenario:
 
         Raises:
             RegistryError: for a registered section missing from the scenario.
+            ArgumentError: ``kind`` is no class (a section's name: read that as
+                ``scenario.sections[name]``).
         """
+        if not isinstance(kind, type):
+            raise wrong_type(
+                "Scenario.section",
+                "kind",
+                kind,
+                "a settings class (NavigationConfig); by name: scenario.sections[name]",
+            )
         found = self._by_type.get(kind)
         if found is None:
             return self._unregistered(kind)
@@ -191,12 +201,28 @@ class Scenario:
         return self.scenario.name
 
     def with_section(self, name: str, section: Any) -> Scenario:
-        """Return a copy with section ``name`` replaced."""
+        """Return a copy with section ``name`` replaced.
+
+        Raises:
+            ArgumentError: a ``name`` that is no string, or a ``section`` that is no
+                settings dataclass instance.
+        """
+        text_argument("Scenario.with_section", "name", name)
+        if not dataclasses.is_dataclass(section) or isinstance(section, type):
+            raise wrong_type(
+                "Scenario.with_section", "section", section, "a settings instance (a dataclass)"
+            )
         return Scenario({**self.sections, name: section}, self.source, self.resolved_with)
 
     def with_seed(self, seed: int) -> Scenario:
-        """Return a copy with another seed."""
-        return self.with_section("scenario", replace(self.scenario, seed=seed))
+        """Return a copy with another seed.
+
+        Raises:
+            ArgumentError: a seed that is no int (a bool, a string); ConfigError: a
+                negative one (:func:`cosim.scenario.arguments.seed_argument`).
+        """
+        checked = seed_argument("Scenario.with_seed", seed)
+        return self.with_section("scenario", replace(self.scenario, seed=checked))
 
     def with_duration(self, duration_s: float) -> Scenario:
         """Return a copy with another duration (s), within the bounds of ``scenario.duration_s``.

@@ -12,18 +12,14 @@ typical indoor setting, below the hardware's 2.0 m/s.
 
 from __future__ import annotations
 
-import re
 from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import ClassVar, Literal
 
 from cosim.scenario.fields import Problem, param
+from cosim.scenario.names import NAME_RULE, name_problem
 
 Layout = Literal["random", "all_rows", "two_corridors"]
-FOLDER_NAME = re.compile(r"[\w.+-]+")
-"""A scenario name: one folder name (letters, digits, ``_``, ``-``, ``.``, ``+``)."""
-NAME_CHARS = 100
-"""Longest scenario name: it names a folder (``runs/NAME-seedN``), at most 255 bytes."""
 Placement = Literal["dock", "random", "explicit"]
 
 
@@ -34,7 +30,11 @@ class ScenarioSection:
     ORDER: ClassVar[int] = 0
     """Where the section comes in a resolved scenario and in the adapters' order."""
 
-    name: str = param("unnamed", "name shown in summaries and folder names")
+    name: str = param(
+        "unnamed",
+        "name shown in summaries and folder names: letters and digits of any script, spaces "
+        "between words, '_', '-', '.', '+'",
+    )
     duration_s: float = param(60.0, "simulated time to run (s)", gt=0, le=1e7)
     seed: int = param(1, "scenario seed; every random stream derives from it", ge=0, unit="id")
     adapters: tuple[str, ...] = param(
@@ -52,19 +52,13 @@ class ScenarioSection:
     )
 
     def problems(self) -> Iterator[Problem]:
-        """The name is one folder name: runs are written to ``runs/NAME-seedN``."""
-        name = self.name
-        if (
-            not FOLDER_NAME.fullmatch(name)
-            or name in (".", "..")
-            or len(name.encode("utf-8")) > NAME_CHARS
-        ):
-            yield Problem(
-                "name",
-                name,
-                f"one folder name of at most {NAME_CHARS} bytes: letters, digits, '_', '-', "
-                "'.' and '+' (no '/', not '.' or '..')",
-            )
+        """The name is one folder name: runs are written to ``runs/NAME-seedN``.
+
+        Any script's letters and digits (:mod:`cosim.scenario.names`).
+        """
+        problem = name_problem(self.name)
+        if problem is not None:
+            yield Problem("name", self.name, f"{NAME_RULE}; {problem}")
 
 
 @dataclass(frozen=True)

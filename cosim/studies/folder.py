@@ -9,20 +9,20 @@ The folder::
 A run's folder appears at once, complete (written beside it, then renamed). ``--resume``
 continues only the study that started the folder: the same runs (seeds, overrides,
 duration, tables) of the same resolved scenario and the same files it reads
-(:func:`fingerprint`). If ``plan.json`` is lost or garbled, the finished runs are the
-evidence: each one's row and ``scenario.toml`` must be what this study would run, and then
-the plan is written again. A run whose ``row.json`` cannot be read, or is not the planned
-run's (its seed or an override differs), is run again.
+(:mod:`cosim.studies.fingerprint`; a section that a package installed since added, and
+that changes no run, is let through: :mod:`cosim.studies.gained`). If ``plan.json`` is
+lost or garbled, the finished runs are the evidence: each one's row and ``scenario.toml``
+must be what this study would run, and then the plan is written again. A run whose
+``row.json`` cannot be read, or is not the planned run's (its seed or an override
+differs), is run again.
 """
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 import shutil
-from collections.abc import Iterator
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -30,18 +30,23 @@ import pandas as pd
 
 from cosim.core.errors import ConfigError, ExportError
 from cosim.runner.faults import FAILURE_FILE
-from cosim.scenario import Scenario, load_scenario
-from cosim.scenario.loader import dump_scenario
-from cosim.studies.spec import RunSpec, StudySpec
-from cosim.studies.worker import Job, Outcome, job_scenario, row_cells, run_overrides
+from cosim.studies.fingerprint import (
+    RUNS_DIR,
+    SCENARIO_FILE,
+    changed,
+    check_fingerprint,
+    fingerprint,
+    gained_since,
+    job_of,
+    scenario_change,
+)
+from cosim.studies.spec import StudySpec
+from cosim.studies.worker import Outcome, row_cells
 
 PLAN_FILE = "plan.json"
-RUNS_DIR = "runs"
 ROW_FILE = "row.json"
-SCENARIO_FILE = "scenario.toml"
 RESULTS_FILE = "results.parquet"
 PARTIAL = ".partial"
-CHUNK = 1 << 20
 
 
 @dataclass(frozen=True)
@@ -67,11 +72,6 @@ class _Found:
     problem: str = ""
 
 
-def job_of(spec: StudySpec, run: RunSpec) -> Job:
-    """The job of a study's run."""
-    return Job(run.run_id, spec.scenario, run.seed, spec.duration_s, run.overrides, spec.tables)
-
-
 def _canonical(value: Any) -> str:
     return json.dumps(value, sort_keys=True, default=str)
 
@@ -79,49 +79,6 @@ def _canonical(value: Any) -> str:
 def _reason(error: OSError) -> str:
     text = error.strerror or str(error)
     return f"{text}: {error.filename}" if error.filename else text
-
-
-def fingerprint(spec: StudySpec) -> dict[str, Any]:
-    """What the runs depend on besides their overrides: the scenario, and files it reads.
-
-    Returns:
-        ``scenario``: sha256 of every combination's resolved scenario (so a changed scenario
-        file, or changed defaults, show); ``files``: sha256 of each file (or folder) a
-        combination names by a path key (an empirical latency CSV, a replayed bag).
-    """
-    digest = hashlib.sha256()
-    files: dict[str, str] = {}
-    for combination in spec.combinations():
-        overrides = run_overrides(combination, seed=None, duration_s=spec.duration_s)
-        scenario = load_scenario(spec.scenario, overrides, override_origin="study")
-        digest.update(dump_scenario(scenario).encode())
-        for name in _read_files(scenario):
-            if name not in files:
-                files[name] = _digest_path(Path(name))
-    return {"scenario": digest.hexdigest(), "files": files}
-
-
-def _read_files(scenario: Scenario) -> Iterator[str]:
-    for _, section in scenario:
-        for f in fields(section):
-            value = getattr(section, f.name)
-            if f.metadata.get("path") and value:
-                yield str(value)
-
-
-def _digest_path(path: Path) -> str:
-    """sha256 of a file's bytes, or of a folder's file names and bytes; "missing" if none."""
-    digest = hashlib.sha256()
-    try:
-        files = sorted(p for p in path.rglob("*") if p.is_file()) if path.is_dir() else [path]
-        for file in files:
-            digest.update(str(file.relative_to(path) if file != path else "").encode())
-            with file.open("rb") as stream:
-                while chunk := stream.read(CHUNK):
-                    digest.update(chunk)
-    except OSError:
-        return "missing"
-    return digest.hexdigest()
 
 
 def plan_of(spec: StudySpec) -> dict[str, Any]:
@@ -237,9 +194,10 @@ def inspect(spec: StudySpec, out: Path, *, resume: bool) -> FolderState:
     finished = {run_id: f.row for run_id, f in found.items() if f.row and f.row["status"] == "ok"}
     if old is not None and (difference := _plan_difference(old, plan)):
         what = f"the study's runs changed ({difference})"
-        raise ConfigError(_changed(spec, out, what, finished))
+        raise ConfigError(changed(spec, out, what, finished))
     if old is not None and isinstance(old.get("fingerprint"), dict):
-        _check_fingerprint(spec, out, old["fingerprint"], plan["fingerprint"], finished)
+        note = check_fingerprint(spec, out, old["fingerprint"], plan["fingerprint"], finished)
+        notes += [note] if note else []
         done = set()
         for run_id in (r for r in finished if r in planned):
             if bad := _unlike(finished[run_id], row_cells(job_of(spec, planned[run_id]))):
@@ -258,16 +216,6 @@ def inspect(spec: StudySpec, out: Path, *, resume: bool) -> FolderState:
                 "which match this study",
             )
     return FolderState(frozenset(done), tuple(notes), text)
-
-
-def _changed(spec: StudySpec, out: Path, what: str, finished: dict[str, Any]) -> str:
-    """The message for a folder started by another study: what changed, what to do."""
-    return (
-        f"{spec.path}: {what} since {out} was started; resuming would mix two studies' runs "
-        f"in one table: restore it to resume, or run this study with another --out (the "
-        f"{len(finished)} finished runs in {out} stay there); deleting {out} to start over "
-        "there loses them"
-    )
 
 
 def _plan_difference(old: dict[str, Any], new: dict[str, Any]) -> str:
@@ -299,57 +247,6 @@ def _run_difference(run_id: str, before: dict[str, Any], now: dict[str, Any]) ->
     return f"run {run_id}: seed {before.get('seed')} then, {now['seed']} now"
 
 
-def _check_fingerprint(
-    spec: StudySpec,
-    out: Path,
-    old: dict[str, Any],
-    new: dict[str, Any],
-    finished: dict[str, Any],
-) -> None:
-    files = old.get("files", {})
-    for name, digest in new["files"].items():
-        if isinstance(files, dict) and files.get(name, digest) != digest:
-            what = f"{name} (a file the scenario reads) changed"
-            raise ConfigError(_changed(spec, out, what, finished))
-    if old.get("scenario") != new["scenario"]:
-        where = _first_scenario_change(spec, out, finished)
-        raise ConfigError(
-            _changed(spec, out, f"the scenario {spec.scenario} changed{where}", finished)
-        )
-
-
-def _first_scenario_change(spec: StudySpec, out: Path, finished: dict[str, Any]) -> str:
-    """`` (run R: `line` then, `line` now)`` from the first finished run, or ""."""
-    planned = {r.run_id: r for r in spec.runs()}
-    for run_id in finished:
-        if run_id in planned:
-            change = _scenario_change(spec, out, planned[run_id])
-            if change:
-                return f" (run {run_id}: {change})"
-    return ""
-
-
-def _scenario_change(spec: StudySpec, out: Path, run: RunSpec) -> str | None:
-    """How a finished run's ``scenario.toml`` differs from what the study runs now.
-
-    Returns:
-        "" when they are the same, the first differing line when not, None when the run
-        has no readable ``scenario.toml``.
-    """
-    try:
-        then = (out / RUNS_DIR / run.run_id / SCENARIO_FILE).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError):
-        return None
-    now = dump_scenario(job_scenario(job_of(spec, run)))
-    if then == now:
-        return ""
-    old_lines, new_lines = then.splitlines(), now.splitlines()
-    for a, b in zip(old_lines, new_lines, strict=False):
-        if a != b:
-            return f"`{a}` then, `{b}` now"
-    return f"{len(old_lines)} lines then, {len(new_lines)} now"
-
-
 def _verify(
     spec: StudySpec, out: Path, finished: dict[str, dict[str, Any]]
 ) -> tuple[set[str], list[str]]:
@@ -359,15 +256,16 @@ def _verify(
         ConfigError: a finished run is not one of this study's, or ran other settings.
     """
     planned = {r.run_id: r for r in spec.runs()}
-    done, notes = set(), []
+    done: set[str] = set()
+    notes: list[str] = []
     for run_id, row in finished.items():
         run = planned.get(run_id)
         if run is None:
             what = f"finished run {run_id} is not one of this study's runs"
-            raise ConfigError(_changed(spec, out, what, finished))
+            raise ConfigError(changed(spec, out, what, finished))
         if bad := _unlike(row, row_cells(job_of(spec, run))):
-            raise ConfigError(_changed(spec, out, f"finished run {run_id} has {bad}", finished))
-        change = _scenario_change(spec, out, run)
+            raise ConfigError(changed(spec, out, f"finished run {run_id} has {bad}", finished))
+        change = scenario_change(spec, out, run)
         if change is None:
             notes.append(
                 f"{out / RUNS_DIR / run_id} has no readable {SCENARIO_FILE} to tell which "
@@ -376,7 +274,9 @@ def _verify(
             continue
         if change:
             what = f"the scenario of finished run {run_id} changed ({change})"
-            raise ConfigError(_changed(spec, out, what, finished))
+            raise ConfigError(changed(spec, out, what, finished))
+        if not done and (note := gained_since(spec, out, run, finished)):
+            notes.append(note)  # a package's new section that changes nothing: said once
         done.add(run_id)
     return done, notes
 

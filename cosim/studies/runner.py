@@ -31,7 +31,8 @@ import pandas as pd
 
 from cosim.core.errors import CosimError, ExportError, WorkerError
 from cosim.studies.cluster import DEFAULT_TIMEOUT_S, check_scheduler, connect, dask_outcomes
-from cosim.studies.folder import collect, finished_rows, inspect, job_of, prepare, write_run
+from cosim.studies.fingerprint import job_of
+from cosim.studies.folder import collect, finished_rows, inspect, prepare, write_run
 from cosim.studies.lifeline import STUDY_PID_VARIABLE, StudyStopped, bind_worker, signal_name
 from cosim.studies.progress import Progress, StudyProgress
 from cosim.studies.spec import StudySpec

@@ -47,7 +47,6 @@ from __future__ import annotations
 
 import itertools
 import math
-import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -56,6 +55,7 @@ from typing import Any
 from cosim.core.errors import ConfigError
 from cosim.scenario.fields import show_name, show_value, suggest
 from cosim.scenario.loader import preset_names
+from cosim.scenario.names import NAME_RULE, name_problem
 from cosim.scenario.tomlfile import read_toml_file
 from cosim.studies.reportspec import REPORT_KEYS, check_report, check_timeseries
 
@@ -65,8 +65,6 @@ SEED_MAX = 2**63 - 1
 """Largest seed: results hold seeds as int64 (numpy's and Parquet's), and so do plans."""
 MAX_RUNS = 1_000_000
 """Most runs a study may have (its plan is written out before the first run)."""
-NAME_PATTERN = re.compile(r"[\w.+-]{1,100}")
-"""A study name is one folder name: word characters, '.', '+', '-'; no separator."""
 IGNORED_IN_STUDIES = ("record.bag", "record.topics", "record.compression", "record.tables")
 """Keys study runs ignore: they write no bag, and ``[study] tables`` picks the tables kept."""
 
@@ -259,12 +257,10 @@ def with_sets(spec: StudySpec, sets: Mapping[str, Any]) -> StudySpec:
 
 def _name(path: Path, name: str) -> str:
     """The study's name becomes a folder name: one path component, nothing to escape with."""
-    if not NAME_PATTERN.fullmatch(name) or not name.strip("."):
+    problem = name_problem(name)
+    if problem is not None:
         raise _fail(
-            path,
-            "study",
-            f"name = {name!r}: expected one folder name of up to 100 letters, digits, '_', "
-            "'-', '.' or '+' (no '/', no '..'), e.g. 'comm_sweep'",
+            path, "study", f"name = {name!r}: expected {NAME_RULE}, e.g. 'comm_sweep'; {problem}"
         )
     return name
 

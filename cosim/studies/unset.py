@@ -19,7 +19,8 @@ from pathlib import Path
 from typing import Any
 
 from cosim.studies.analysis import RESULTS_FILE, load_results
-from cosim.studies.folder import RUNS_DIR, SCENARIO_FILE, write_results
+from cosim.studies.fingerprint import RUNS_DIR, SCENARIO_FILE
+from cosim.studies.folder import write_results
 
 NAMED = 10
 """Runs a note names; the others are counted."""

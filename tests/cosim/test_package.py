@@ -8,10 +8,11 @@ import pytest
 import cosim
 from cosim.core import errors
 from cosim.runner import execute, result
-from cosim.scenario import loader, model
+from cosim.scenario import arguments, loader, model
 from tests.conftest import REPO
 
 DEFINED_IN = {
+    "ArgumentError": arguments,
     "BridgeError": errors,
     "ConfigError": errors,
     "CosimError": errors,

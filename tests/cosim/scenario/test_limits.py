@@ -8,7 +8,7 @@ from cosim.core.errors import ConfigError
 from cosim.scenario import parse_override, preset_names
 
 
-@pytest.mark.parametrize("name", ["../escape", "a/b", "/abs", "..", ".", "", "a b", "x\ny"])
+@pytest.mark.parametrize("name", ["../escape", "a/b", "/abs", "..", ".", "", " a", "x\ny"])
 def test_a_scenario_name_that_is_not_one_folder_name_is_refused_naming_the_file_and_key(
     tmp_path, name
 ):
@@ -51,6 +51,9 @@ def test_a_set_value_nested_thousands_deep_is_one_line_naming_the_key():
 @pytest.mark.parametrize("duration_s", [1e30, float("inf"), float("nan"), 0.0, -1.0, True])
 def test_a_duration_given_in_code_keeps_the_bounds_of_the_key(duration_s):
     scenario = cosim.load_scenario("warehouse-random")
-    with pytest.raises(ConfigError, match=r"^duration_s = .*: expected a number >= 1e-06 and <="):
+    with pytest.raises(
+        ConfigError,
+        match=r"^cosim.run\(duration_s=.*\): expected a number of seconds >= 1e-06 and <=",
+    ):
         cosim.run(scenario, duration_s=duration_s)
     assert scenario.with_duration(1e7).scenario.duration_s == 1e7
