@@ -339,9 +339,10 @@ def _cmd_study(args: argparse.Namespace) -> int:
     from cosim.studies.runner import Progress, run_study
     from cosim.studies.validate import load_study
 
-    # SIGTERM stops a study as Ctrl-C does: finished runs kept, one line, 128 + the signal
+    # SIGTERM stops a study as Ctrl-C does: finished runs kept, one line, 128 + the signal;
+    # a run in this process takes it at its next event boundary, so no signal is lost
     try:
-        with stop_on_signals():
+        with stop_on_signals() as stop:
             spec = load_study(args.study, dict(map(parse_override, args.overrides)))
             out = args.out or Path("runs") / "studies" / spec.name
             total = len(spec.runs())
@@ -363,10 +364,11 @@ def _cmd_study(args: argparse.Namespace) -> int:
                 scheduler_timeout_s=args.scheduler_timeout_s,
                 resume=args.resume,
                 progress=None if args.quiet else Progress(),
+                stop=stop,
             )
-    except StudyStopped as stop:
-        print(f"cosim: {stop.message}", file=sys.stderr)
-        return stop.exit_status
+    except StudyStopped as stopped:
+        print(f"cosim: {stopped.message}", file=sys.stderr)
+        return stopped.exit_status
     failed = int((results["status"] != "ok").sum()) if len(results) else 0
     print(
         f"results: {out}/results.parquet ({len(results)} runs, {failed} failed)"
