@@ -126,7 +126,7 @@ def _run_and_report(args: argparse.Namespace, stop: StopRequest, ran: list[Path]
     from adapters.physical.domain import claim_run_domain
     from adapters.physical.launcher import Standins
     from adapters.unity.server import UnityOptions
-    from cosim.cli.hostname import check_live_host
+    from cosim.cli.hostname import Listener, check_live_host, check_ports
     from cosim.recording.foxglove import LiveOptions
     from cosim.runner.execute import run
     from cosim.runner.stopping import RunStopped
@@ -140,6 +140,15 @@ def _run_and_report(args: argparse.Namespace, stop: StopRequest, ran: list[Path]
         check_live_host(args.live_host)
     if args.unity:
         check_live_host(args.unity_host, flag="--unity-host")
+    # two servers on one port: the second would blame "address in use" on another program
+    listeners = []
+    if args.live:
+        listeners.append(Listener("the live view", "--live-port", args.live_host, args.live_port))
+    if args.unity:
+        listeners.append(
+            Listener("the Unity endpoint", "--unity-port", args.unity_host, args.unity_port)
+        )
+    check_ports(*listeners)
     out = _out_folder(args, scenario, quiet=args.quiet)
     live = (
         LiveOptions(args.live_host, args.live_port, args.live_rate, args.live_wait)
