@@ -113,6 +113,18 @@ def _overlap(one: str, other: str) -> bool:
     return bool(first & second or (first | second) & WILDCARDS)
 
 
+def run_listeners(args: argparse.Namespace) -> list[Listener]:
+    """The servers ``cosim run``'s flags ask for: the live view and the Unity endpoint."""
+    listeners = []
+    if args.live:
+        listeners.append(Listener("the live view", "--live-port", args.live_host, args.live_port))
+    if args.unity:
+        listeners.append(
+            Listener("the Unity endpoint", "--unity-port", args.unity_host, args.unity_port)
+        )
+    return listeners
+
+
 def check_ports(*listeners: Listener) -> None:
     """Refuse two servers of one run given the same port (0, any free port, never clashes).
 

@@ -126,7 +126,7 @@ def _run_and_report(args: argparse.Namespace, stop: StopRequest, ran: list[Path]
     from adapters.physical.domain import claim_run_domain
     from adapters.physical.launcher import Standins
     from adapters.unity.server import UnityOptions
-    from cosim.cli.hostname import Listener, check_live_host, check_ports
+    from cosim.cli.hostname import check_live_host, check_ports, run_listeners
     from cosim.recording.foxglove import LiveOptions
     from cosim.runner.execute import run
     from cosim.runner.stopping import RunStopped
@@ -140,15 +140,7 @@ def _run_and_report(args: argparse.Namespace, stop: StopRequest, ran: list[Path]
         check_live_host(args.live_host)
     if args.unity:
         check_live_host(args.unity_host, flag="--unity-host")
-    # two servers on one port: the second would blame "address in use" on another program
-    listeners = []
-    if args.live:
-        listeners.append(Listener("the live view", "--live-port", args.live_host, args.live_port))
-    if args.unity:
-        listeners.append(
-            Listener("the Unity endpoint", "--unity-port", args.unity_host, args.unity_port)
-        )
-    check_ports(*listeners)
+    check_ports(*run_listeners(args))  # one port for two: "in use" would blame another program
     out = _out_folder(args, scenario, quiet=args.quiet)
     live = (
         LiveOptions(args.live_host, args.live_port, args.live_rate, args.live_wait)
@@ -348,8 +340,7 @@ def _cmd_study(args: argparse.Namespace) -> int:
     from cosim.studies.runner import Progress, run_study
     from cosim.studies.validate import load_study
 
-    # SIGTERM stops a study as Ctrl-C does: finished runs kept, one line, 128 + the signal;
-    # a run in this process takes it at its next event boundary, so no signal is lost
+    # SIGTERM stops a study as Ctrl-C does: finished runs kept, one line, 128 + the signal
     try:
         with stop_on_signals() as stop:
             spec = load_study(args.study, dict(map(parse_override, args.overrides)))

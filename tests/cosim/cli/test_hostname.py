@@ -17,6 +17,7 @@ from cosim.cli.hostname import (
     check_ports,
     host_argument,
     is_host,
+    run_listeners,
 )
 from cosim.core.errors import ConfigError
 
@@ -172,3 +173,16 @@ def test_port_0_is_any_free_port_for_each_server_and_different_ports_never_clash
 def test_every_interface_of_ipv6_counts_as_taking_ipv4_too():
     with pytest.raises(ConfigError, match=r"^--a-port 9 and --b-port 9 name the same port"):
         check_ports(Listener("a", "--a-port", "::", 9), Listener("b", "--b-port", "127.0.0.1", 9))
+
+
+@pytest.mark.parametrize(
+    ("live", "unity"), [(True, True), (True, False), (False, True), (False, False)]
+)
+def test_the_servers_of_a_run_are_those_its_flags_turn_on(live, unity):
+    args = argparse.Namespace(
+        live=live, live_host="0.0.0.0", live_port=9, unity=unity, unity_host="::1", unity_port=9
+    )
+    expected = [Listener("the live view", "--live-port", "0.0.0.0", 9)] * live + [
+        Listener("the Unity endpoint", "--unity-port", "::1", 9)
+    ] * unity
+    assert run_listeners(args) == expected
