@@ -72,7 +72,7 @@ class UnityPoseSource(PolledSource):
         Raises:
             LiveSourceError: the run serves no Unity scene (no ``--unity``): no pose can come.
         """
-        if self.endpoint() is None:
+        if self.endpoint() is None and self.context.tracked:
             index, body = self.context.tracked[0]
             raise LiveSourceError(
                 f"mocap.source = 'unity': no pose of {self.names[index]} can come (on {body}): "
