@@ -11,7 +11,11 @@ Nothing waits for the system: each poll asks whether the source failed
 (:meth:`PolledSource.failure`) and, once ``mocap.connect_timeout_s`` has passed without
 a pose of some tracked robot, ends the run with :class:`LiveSourceError` saying what the
 source got that far (:meth:`PolledSource.silence`) and which keys say where it is
-(:attr:`PolledSource.settings_hint`).
+(:attr:`PolledSource.settings_hint`). A run that ends before the timeout was reached
+(``scenario.duration_s`` shorter than it) fails the same way at its last poll when some
+tracked robot has had no pose: a run that asked for live poses and got none is a mistake,
+never a success with an empty table. ``mocap_connected`` in the summary says whether any
+pose came from the source.
 """
 
 from __future__ import annotations
@@ -23,7 +27,8 @@ from adapters.mocap.contract import SourceContext
 from cosim.core.adapter import RunContext
 from cosim.core.errors import BridgeError
 from cosim.core.kernel import Stage
-from cosim.core.timebase import period_ns, s_to_ns
+from cosim.core.timebase import NS_PER_S, period_ns, s_to_ns
+from cosim.scenario.sections import ScenarioSection
 from models.fleet.kinematics import FleetState
 
 Sample = tuple[int, int, float, float, float]
@@ -56,7 +61,10 @@ class PolledSource:
         self.names = list(context.run.service(FleetState).names)
         self.tracked = [index for index, _ in context.tracked]
         self._unheard: set[int] = set()
+        self._start_ns = 0
         self._deadline_ns = 0
+        self._end_ns = s_to_ns(context.run.settings(ScenarioSection).duration_s)
+        self._period_ns = period_ns(self.cfg.rate_hz)
         self._connected = False
         self._summary: dict[str, Any] = {}
 
@@ -74,8 +82,17 @@ class PolledSource:
         """Take the counts and disconnect, once (nothing if it never connected)."""
         if self._connected:
             self._connected = False
-            self._summary = dict(self.counts())
+            heard = len(self._unheard) < len(self.tracked)
+            self._summary = {"mocap_connected": heard, **self.counts()}
             self.disconnect()
+
+    @property
+    def waited_s(self) -> float:
+        """How long the source is waited for (s), for :meth:`silence`.
+
+        ``mocap.connect_timeout_s``, or the whole run when it ends sooner.
+        """
+        return min(self.cfg.connect_timeout_s, (self._end_ns - self._start_ns) / NS_PER_S)
 
     def summary(self) -> Mapping[str, Any]:
         """The counts taken when the source closed (none before)."""
@@ -99,15 +116,17 @@ class PolledSource:
         self._connected = True
         self.recorder = run.recorder
         self._unheard = set(self.tracked)
-        self._deadline_ns = run.kernel.now_ns + s_to_ns(self.cfg.connect_timeout_s)
-        run.kernel.every(period_ns(self.cfg.rate_hz), self._poll, stage=Stage.SENSING)
+        self._start_ns = run.kernel.now_ns
+        self._deadline_ns = self._start_ns + s_to_ns(self.cfg.connect_timeout_s)
+        run.kernel.every(self._period_ns, self._poll, stage=Stage.SENSING)
 
     def _poll(self, now_ns: int) -> None:
         """Take in what arrived; end the run on a failed or (at first) silent source.
 
         Raises:
             LiveSourceError: the source failed, or a tracked robot has had no pose
-                ``mocap.connect_timeout_s`` after the start.
+                ``mocap.connect_timeout_s`` after the start, or at the run's last poll
+                when the run ends sooner.
         """
         submit = self.context.intake.submit
         for index, stamp_ns, x, y, yaw in self.take(now_ns):
@@ -118,11 +137,20 @@ class PolledSource:
         if failure is not None:
             self.recorder.event(now_ns, host, "mocap_failed", failure)
             raise LiveSourceError(f"{failure}; {self._expected()}")
-        if self._unheard and now_ns >= self._deadline_ns:
+        if not self._unheard:
+            return
+        last_poll = now_ns + self._period_ns >= self._end_ns
+        if now_ns >= self._deadline_ns or last_poll:
             index = min(self._unheard)
             text = self.silence(index)
             self.recorder.event(now_ns, self.names[index], "no_pose", text)
-            raise LiveSourceError(f"{text}; {self._expected()}")
+            if now_ns >= self._deadline_ns:
+                raise LiveSourceError(f"{text}; {self._expected()}")
+            raise LiveSourceError(
+                f"{text}; the run ended at {self._end_ns / NS_PER_S:g} s, within "
+                f"mocap.connect_timeout_s = {self.cfg.connect_timeout_s:g} s: expected a pose "
+                f"of every tracked robot before the run ends (see {self.settings_hint})"
+            )
 
     def _expected(self) -> str:
         """What a live source needs, and the keys that say where it is."""

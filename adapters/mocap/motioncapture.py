@@ -105,7 +105,7 @@ class MotionCaptureSource(PolledSource):
 
     def silence(self, index: int) -> str:
         """Not connected, connected but no frame, or frames without this robot's body."""
-        feed, waited = self.feed, f"{self.cfg.connect_timeout_s:g} s"
+        feed, waited = self.feed, f"{self.waited_s:g} s"
         if not feed.connected:
             return f"{self.where()} did not answer within {waited} (no connection)"
         if feed.frames == 0:

@@ -111,7 +111,7 @@ class Ros2PoseSource(PolledSource):
     def silence(self, index: int) -> str:
         """The topic and the DDS domain listened on."""
         return (
-            f"no pose of {self.names[index]} within {self.cfg.connect_timeout_s:g} s: listened "
+            f"no pose of {self.names[index]} within {self.waited_s:g} s: listened "
             f"for geometry_msgs/PoseStamped on {self.topic[index]} on {self.session.where()} "
             "(mocap.source = 'ros2')"
         )

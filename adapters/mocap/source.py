@@ -7,9 +7,10 @@
 The robots an external source tracks are twins that follow its poses; those a simulated
 one tracks drive by their commands. A live source never makes the run wait: one that
 fails ends the run at once, and one that has sent no pose of some tracked robot
-``mocap.connect_timeout_s`` after the start ends it then
-(:class:`~adapters.mocap.live.LiveSourceError`, one line naming the system, its host,
-the robot and what was listened for; an event ``no_pose`` or ``mocap_failed``).
+``mocap.connect_timeout_s`` after the start ends it then, or at the run's end when
+that comes sooner (:class:`~adapters.mocap.live.LiveSourceError`, one line naming the
+system, its host, the robot and what was listened for; an event ``no_pose`` or
+``mocap_failed``).
 
 Every pose goes through :class:`adapters.mocap.intake.PoseIntake` and is published on
 ``/<robot>/pose`` from the ``mocap`` host, so it crosses the network model to the robot.

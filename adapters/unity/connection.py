@@ -4,12 +4,17 @@ A reader thread takes the scene's frames and acts on each (:func:`adapters.unity
 given by the endpoint); a writer thread sends the frames queued for the scene, and a
 keepalive after :data:`KEEPALIVE_S` without anything, so the Connector never takes an idle
 run for a lost one. A frame that breaks the protocol ends the connection (the Connector
-reconnects); a refused one is answered with ``__error`` and counted.
+reconnects); a refused one is answered with ``__error`` and counted. Whatever the bytes,
+the reader thread never dies of them: anything else that goes wrong handling a frame ends
+that connection the same way, in one line. Each refusal is logged in one line naming the
+peer (logger ``adapters.unity``, a warning: on stderr unless the application configures
+logging), the first :data:`LOGGED_REFUSALS` of a connection; the rest are counted only.
 """
 
 from __future__ import annotations
 
 import contextlib
+import logging
 import queue
 import socket
 import threading
@@ -22,6 +27,11 @@ KEEPALIVE_S = 1.0
 """A connection idle this long (wall-clock s) gets a keepalive."""
 QUEUE_FRAMES = 10_000
 """Frames waiting for a slow connection; more are dropped (and counted)."""
+LOGGED_REFUSALS = 5
+"""Refusals of one connection logged; the later ones are counted (``unity_frames_rejected``)."""
+LINE_CHARS = 300
+"""A logged line is cut to this many characters (a refusal may quote what the scene sent)."""
+LOG = logging.getLogger("adapters.unity")
 
 Handler = Callable[["Connection", str, bytes], None]
 """What acts on one frame (destination, payload); raises ValueError to refuse it."""
@@ -34,12 +44,15 @@ class Connection:
         sink: the endpoint (its counts, and what ``handle`` acts on).
         conn: the connected socket.
         handle: what acts on each frame.
+        peer: who is connected, for the log (``127.0.0.1:53412``).
     """
 
-    def __init__(self, sink: Any, conn: socket.socket, handle: Handler) -> None:
+    def __init__(self, sink: Any, conn: socket.socket, handle: Handler, peer: str = "") -> None:
         self.sink = sink
         self.conn = conn
         self.handle = handle
+        self.peer = peer or "a scene"
+        self.refusals = 0
         self.subscriptions: frozenset[str] = frozenset()
         self.publishes: dict[str, str] = {}
         self.outbox: queue.Queue[bytes | None] = queue.Queue(QUEUE_FRAMES)
@@ -88,12 +101,25 @@ class Connection:
                 self.sink.count("unity_frames_received")
                 self._handle(*got)
         except frames.FrameError as problem:  # the stream is lost: the Connector reconnects
-            self.sink.count("unity_frames_rejected")
-            self.send(frames.error(f"cosim: {problem}; closing the connection"))
+            self._refuse(f"{problem}; closing the connection")
         except OSError:
             pass
+        except Exception as problem:  # whatever a scene sent, the thread ends cleanly
+            what = f"{type(problem).__name__}: {problem}"
+            self._refuse(f"cannot handle a frame ({what}); closing the connection")
         finally:
             self._end_after_sending()
+
+    def _refuse(self, line: str) -> None:
+        """Count a refused frame, answer it with ``__error`` and log it (one line each)."""
+        line = " ".join(line.splitlines())  # one line, whatever an exception said
+        self.sink.count("unity_frames_rejected")
+        self.send(frames.error(f"cosim: {line}"))
+        self.refusals += 1
+        if self.refusals > LOGGED_REFUSALS:
+            return
+        last = "; its further refusals are only counted" if self.refusals == LOGGED_REFUSALS else ""
+        LOG.warning("unity: refused a frame from %s: %s%s", self.peer, line[:LINE_CHARS], last)
 
     def _end_after_sending(self) -> None:
         """Unity is gone or lost: send what is queued (an ``__error``), then end."""
@@ -106,8 +132,7 @@ class Connection:
         try:
             self.handle(self, destination, payload)
         except ValueError as problem:
-            self.sink.count("unity_frames_rejected")
-            self.send(frames.error(f"cosim: {problem}"))
+            self._refuse(str(problem))
 
     def read_next(self) -> bytes:
         """The payload of the frame after ``__request``/``__response``."""

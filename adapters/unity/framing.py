@@ -11,6 +11,7 @@ empty payload (8 zero bytes) is a keepalive.
 from __future__ import annotations
 
 import json
+import re
 import socket
 import struct
 from collections.abc import Mapping
@@ -24,7 +25,20 @@ MAX_DESTINATION_BYTES = 1024
 """Longest destination accepted; a longer length prefix means the stream is garbage."""
 MAX_PAYLOAD_BYTES = 16 * 1024 * 1024
 """Largest payload accepted (16 MiB: a PoseStamped or Twist is under 100 bytes)."""
+MAX_COMMAND_BYTES = 64 * 1024
+"""Largest JSON of a command accepted (the Connector's are under 1 KiB)."""
+MAX_JSON_DEPTH = 32
+"""Deepest nesting of arrays and objects accepted in a command's JSON (the Connector's: 1).
+
+Python's JSON parser recurses once per level and raises ``RecursionError`` past about a
+thousand; the depth is measured before parsing, so a deeper payload is refused as any
+malformed one."""
 _U32 = struct.Struct("<I")
+_JSON_TOKEN = re.compile(rb'"(?:[^"\\]+|\\.)*"?|[][{}]', re.DOTALL)
+"""A JSON string, escapes included (its brackets are text, not nesting), or a bracket.
+
+An unterminated string runs to the end: the match never fails once it has begun, so it
+never backtracks (requiring the closing quote, a run of escaped quotes took quadratic time)."""
 
 
 class FrameError(Exception):
@@ -106,16 +120,45 @@ def read_frame(sock: socket.socket) -> tuple[str, bytes] | None:
     return destination, payload
 
 
+def json_depth(data: bytes) -> int:
+    """How deep arrays and objects nest in the JSON text ``data`` (0 for a scalar).
+
+    Brackets inside strings are not counted; unbalanced ones are counted as they open,
+    so the result is an upper bound for malformed text (which the parser refuses anyway).
+    """
+    depth = deepest = 0
+    for token in _JSON_TOKEN.findall(data):
+        if token in (b"[", b"{"):
+            depth += 1
+            deepest = max(deepest, depth)
+        elif token in (b"]", b"}"):
+            depth -= 1
+    return deepest
+
+
 def parse_json(destination: str, payload: bytes) -> dict[str, Any]:
     """A command's JSON object (its trailing NUL stripped).
 
     Raises:
-        ValueError: naming the command, when the payload is not a JSON object.
+        ValueError: naming the command, when the payload is not a JSON object, is larger
+            than :data:`MAX_COMMAND_BYTES` or nests deeper than :data:`MAX_JSON_DEPTH`.
     """
+    if len(payload) > MAX_COMMAND_BYTES:
+        raise ValueError(
+            f"{destination}: a JSON payload of {len(payload)} bytes; expected at most "
+            f"{MAX_COMMAND_BYTES} (a command is a small flat object)"
+        )
+    depth = json_depth(payload)
+    if depth > MAX_JSON_DEPTH:
+        raise ValueError(
+            f"{destination}: JSON nested {depth} levels deep; expected at most "
+            f"{MAX_JSON_DEPTH} (a command is a flat object)"
+        )
     try:
         value = json.loads(payload.rstrip(b"\x00").decode("utf-8") or "{}")
-    except (UnicodeDecodeError, json.JSONDecodeError) as problem:
-        raise ValueError(f"{destination}: the payload is not JSON ({problem})") from None
+    except (UnicodeDecodeError, ValueError, RecursionError) as problem:
+        reason = " ".join(str(problem).split())[:200]
+        raise ValueError(f"{destination}: the payload is not JSON ({reason})") from None
     if not isinstance(value, dict):
         raise ValueError(f"{destination}: expected a JSON object, got {type(value).__name__}")
     return value

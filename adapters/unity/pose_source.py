@@ -10,7 +10,10 @@ scenes ``__publish`` on the topics behind the prefix, checks every sample (a CDR
 PoseStamped, in ``map``, finite) and publishes the newest one of each topic from the
 ``mocap`` host every 50 ms, stamped with the kernel time it takes it in (Unity's clock is
 not the run's). This source keeps them until it is polled, and the pose intake checks
-them as any live pose (stale, off the map, a jump).
+them as any live pose (stale, off the map, a jump). The runner offers the run's endpoint as
+a service (:class:`~adapters.unity.server.UnitySink`): a run serving no Unity scene, where
+no pose can ever come, ends as it starts, and a silent one names where scenes had to
+connect.
 """
 
 from __future__ import annotations
@@ -19,12 +22,14 @@ from collections.abc import Iterator, Mapping
 from typing import Any, ClassVar
 
 from adapters.mocap.contract import SourceContext, Tracked
-from adapters.mocap.live import PolledSource, Sample
+from adapters.mocap.live import LiveSourceError, PolledSource, Sample
 from adapters.mocap.ros2 import pattern_tracks, topic_bodies_problems
 from adapters.mocap.settings import MocapConfig
+from adapters.unity.server import UnitySink
 from adapters.unity.topics import pose_bus_topic
 from cosim.core.adapter import RunContext
 from cosim.core.bus import Envelope
+from cosim.core.errors import RegistryError
 from cosim.core.messages import Message, PoseStamped
 from cosim.core.summary import SummaryKey
 from cosim.scenario.fields import Problem
@@ -72,7 +77,18 @@ class UnityPoseSource(PolledSource):
             context.run.bus.advertise(pose_bus_topic(body), PoseStamped)
 
     def connect(self, run: RunContext) -> None:
-        """Listen on every body's bus topic on the ``mocap`` host."""
+        """Listen on every body's bus topic on the ``mocap`` host.
+
+        Raises:
+            LiveSourceError: the run serves no Unity scene (no ``--unity``): no pose can come.
+        """
+        if self.endpoint() is None and self.context.tracked:
+            index, body = self.context.tracked[0]
+            raise LiveSourceError(
+                f"mocap.source = 'unity': no pose of {self.names[index]} can come (on {body}): "
+                "this run serves no Unity scene; expected cosim run --unity "
+                "(from Python: cosim.run(..., unity=UnityOptions()))"
+            )
         for index, body in self.context.tracked:
             run.bus.subscribe(pose_bus_topic(body), self.context.host, self._on_pose(index))
 
@@ -98,10 +114,26 @@ class UnityPoseSource(PolledSource):
         """Poses received from Unity (before the intake's checks)."""
         return {"mocap_unity_poses": self.received, "mocap_unity_not_in_map": self.not_in_map}
 
+    def endpoint(self) -> UnitySink | None:
+        """The run's Unity endpoint, or None when it serves no Unity scene."""
+        try:
+            return self.context.run.service(UnitySink)
+        except RegistryError:
+            return None
+
     def silence(self, index: int) -> str:
-        """The topic listened on, and how a scene must send it."""
+        """The topic listened on, where scenes connect, and how a scene must send it."""
+        sink = self.endpoint()
+        if sink is None:
+            where = "no ROS-TCP-Endpoint (run with --unity)"
+        else:
+            clients = sink.summary()["unity_clients"]
+            where = (
+                f"the ROS-TCP-Endpoint at {sink.options.host}:{sink.port} ({clients} "
+                "connections; a scene registers the topic with __publish, then publishes)"
+            )
         return (
-            f"no pose of {self.names[index]} within {self.cfg.connect_timeout_s:g} s: listened "
-            f"for geometry_msgs/PoseStamped in 'map' on {self.topic[index]} from Unity scenes "
-            "(mocap.source = 'unity': run with --unity and have the scene publish it)"
+            f"no pose of {self.names[index]} within {self.waited_s:g} s: listened for "
+            f"geometry_msgs/PoseStamped in 'map' on {self.topic[index]} from Unity scenes on "
+            f"{where}"
         )

@@ -19,7 +19,7 @@ import socket
 import threading
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import ClassVar, Protocol
+from typing import Any, ClassVar, Protocol
 
 from adapters.drivers.topics import teleop_topic
 from adapters.navigation.topics import goal_topic
@@ -54,6 +54,14 @@ COUNTS = ("unity_clients", "unity_frames_received", "unity_frames_rejected", "un
 run takes them)."""
 MOCAP_HOST = HostId("mocap")
 """The host tracked poses from Unity are published from (the mocap adapter's)."""
+
+
+def peer_name(address: Any) -> str:
+    """``127.0.0.1:53412`` (``[::1]:53412`` for IPv6) of an accepted connection's address."""
+    if isinstance(address, tuple) and len(address) >= 2:
+        host = str(address[0])
+        return f"[{host}]:{address[1]}" if ":" in host else f"{host}:{address[1]}"
+    return str(address)
 
 
 class Channel(Protocol):
@@ -191,13 +199,13 @@ class UnitySink:
         assert server is not None
         while not self._stopping.is_set():
             try:
-                conn, _address = server.accept()
+                conn, address = server.accept()
             except TimeoutError:
                 continue
             except OSError:
                 return
             conn.settimeout(None)
-            client = Connection(self, conn, handle)
+            client = Connection(self, conn, handle, peer=peer_name(address))
             with self._lock:
                 self._clients.append(client)
                 self.counts["unity_clients"] += 1

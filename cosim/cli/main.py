@@ -126,7 +126,7 @@ def _run_and_report(args: argparse.Namespace, stop: StopRequest, ran: list[Path]
     from adapters.physical.domain import claim_run_domain
     from adapters.physical.launcher import Standins
     from adapters.unity.server import UnityOptions
-    from cosim.cli.hostname import check_live_host
+    from cosim.cli.hostname import check_live_host, check_ports, run_listeners
     from cosim.recording.foxglove import LiveOptions
     from cosim.runner.execute import run
     from cosim.runner.stopping import RunStopped
@@ -140,6 +140,7 @@ def _run_and_report(args: argparse.Namespace, stop: StopRequest, ran: list[Path]
         check_live_host(args.live_host)
     if args.unity:
         check_live_host(args.unity_host, flag="--unity-host")
+    check_ports(*run_listeners(args))  # one port for two: "in use" would blame another program
     out = _out_folder(args, scenario, quiet=args.quiet)
     live = (
         LiveOptions(args.live_host, args.live_port, args.live_rate, args.live_wait)
@@ -341,7 +342,7 @@ def _cmd_study(args: argparse.Namespace) -> int:
 
     # SIGTERM stops a study as Ctrl-C does: finished runs kept, one line, 128 + the signal
     try:
-        with stop_on_signals():
+        with stop_on_signals() as stop:
             spec = load_study(args.study, dict(map(parse_override, args.overrides)))
             out = args.out or Path("runs") / "studies" / spec.name
             total = len(spec.runs())
@@ -363,10 +364,11 @@ def _cmd_study(args: argparse.Namespace) -> int:
                 scheduler_timeout_s=args.scheduler_timeout_s,
                 resume=args.resume,
                 progress=None if args.quiet else Progress(),
+                stop=stop,
             )
-    except StudyStopped as stop:
-        print(f"cosim: {stop.message}", file=sys.stderr)
-        return stop.exit_status
+    except StudyStopped as stopped:
+        print(f"cosim: {stopped.message}", file=sys.stderr)
+        return stopped.exit_status
     failed = int((results["status"] != "ok").sum()) if len(results) else 0
     print(
         f"results: {out}/results.parquet ({len(results)} runs, {failed} failed)"

@@ -136,6 +136,8 @@ def execute(
             with _immediate(stop):
                 if plan.active:
                     session.open(before_bag=prepare)
+                    if session.unity is not None:  # where the run's Unity poses come from
+                        run.provide(session.unity)
                 elif prepare is not None:
                     prepare()
                 if on_ready is not None:

@@ -9,6 +9,12 @@ the world, waiting for a viewer) a signal stops at once. A second signal while t
 are written stops at once too. Either way :class:`RunStopped` is raised, a
 ``KeyboardInterrupt``, so that code stopping on Ctrl-C stops on it too.
 
+While deferring, the handler raises nothing: an exception raised by a signal handler lands
+wherever Python happened to be, and where that is a Python callback called from compiled code
+(python-fcl's collision and distance callbacks, ``noexcept`` in Cython) it is printed as
+"Exception ignored in" and dropped, and the signal with it. The runner looks at the request
+between events instead, where nothing can drop it.
+
 A signal the process was started to ignore (``nohup`` ignores SIGHUP) stays ignored.
 """
 
@@ -17,7 +23,7 @@ from __future__ import annotations
 import contextlib
 import signal
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from types import FrameType
 from typing import TYPE_CHECKING
 
@@ -63,11 +69,16 @@ class StopRequest:
     """Whether a signal asked the run to stop, and which.
 
     The signal handler of :func:`stop_on_signals` sets it while :meth:`deferred`; outside,
-    the handler raises :class:`RunStopped` at once.
+    the handler raises at once.
+
+    Args:
+        stopped: the exception a stop raises, built from the signal's number
+            (:class:`RunStopped`; a study's is :class:`~cosim.studies.lifeline.StudyStopped`).
     """
 
-    def __init__(self) -> None:
+    def __init__(self, stopped: Callable[[int], KeyboardInterrupt] = RunStopped) -> None:
         self.signum: int | None = None
+        self.stopped = stopped
         self._deferring = False
 
     @property
@@ -79,14 +90,24 @@ class StopRequest:
         """The signal handler: note the stop while deferring; stop at once otherwise.
 
         Raises:
-            RunStopped: outside :meth:`deferred`, or for a second signal.
+            KeyboardInterrupt: ``stopped(signum)``, outside :meth:`deferred` or for a second
+                signal.
         """
         if self._deferring and self.signum is None:
             self.signum = signum
             return
         if self.signum is None:
             self.signum = signum
-        raise RunStopped(signum)
+        raise self.stopped(signum)
+
+    def raise_if_requested(self) -> None:
+        """Stop now if a stop was asked for (where a deferred stop is acted on).
+
+        Raises:
+            KeyboardInterrupt: ``stopped(signum)`` of the signal that asked.
+        """
+        if self.signum is not None:
+            raise self.stopped(self.signum)
 
     @contextlib.contextmanager
     def deferred(self) -> Iterator[None]:
@@ -102,10 +123,9 @@ class StopRequest:
         """While inside, a signal stops at once; a stop already asked for stops on entry.
 
         Raises:
-            RunStopped: on entry, if a stop was asked for.
+            KeyboardInterrupt: ``stopped(signum)`` on entry, if a stop was asked for.
         """
-        if self.signum is not None:
-            raise RunStopped(self.signum)
+        self.raise_if_requested()
         previous, self._deferring = self._deferring, False
         try:
             yield
@@ -114,13 +134,19 @@ class StopRequest:
 
 
 @contextlib.contextmanager
-def stop_on_signals(signals: tuple[int, ...] = STOP_SIGNALS) -> Iterator[StopRequest]:
+def stop_on_signals(
+    signals: tuple[int, ...] = STOP_SIGNALS, request: StopRequest | None = None
+) -> Iterator[StopRequest]:
     """While inside, ``signals`` stop the run through the :class:`StopRequest` yielded.
 
     Only the main thread can take signals; elsewhere the request is never set. A signal
     whose handler is ``SIG_IGN`` when entering (``nohup``) is left ignored.
+
+    Args:
+        signals: the signals that stop.
+        request: the request they set (a new one raising :class:`RunStopped` by default).
     """
-    request = StopRequest()
+    request = request if request is not None else StopRequest()
     if threading.current_thread() is not threading.main_thread():
         yield request
         return

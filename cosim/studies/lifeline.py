@@ -9,6 +9,10 @@ watches the study's process id instead.
 
 SIGTERM (and SIGHUP, a closed terminal) stop a study the way Ctrl-C does
 (:func:`stop_on_signals`): the runner keeps the finished runs and the folder resumable.
+A run of the study process itself (one worker) only notes the signal while its kernel runs
+and stops at the next event boundary (:class:`~cosim.runner.stopping.StopRequest`): raised
+inside the run, the stop could land in a callback of compiled code (python-fcl's) that
+drops exceptions, and the study would run on.
 """
 
 from __future__ import annotations
@@ -19,15 +23,17 @@ import signal
 import threading
 import time
 from collections.abc import Iterator
-from types import FrameType
 
 from adapters.processes import die_with_parent
+from cosim.runner import stopping
+from cosim.runner.stopping import StopRequest
 
 STUDY_PID_VARIABLE = "COSIM_STUDY_PID"
 """Environment variable naming the study process, for its fork server."""
 WATCH_PERIOD_S = 1.0
 """How often a worker without ``prctl`` checks that its study still runs (s)."""
-STOP_SIGNALS = (signal.SIGTERM, signal.SIGHUP)
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+"""The signals that stop a study (and keep its finished runs)."""
 
 
 class StudyStopped(KeyboardInterrupt):
@@ -60,26 +66,18 @@ def signal_name(signum: int) -> str:
         return f"signal {signum}"
 
 
-def _raise_stopped(signum: int, _frame: FrameType | None) -> None:
-    raise StudyStopped(signum)
-
-
 @contextlib.contextmanager
-def stop_on_signals() -> Iterator[None]:
-    """While inside, SIGTERM and SIGHUP stop the study as Ctrl-C does.
+def stop_on_signals() -> Iterator[StopRequest]:
+    """While inside, Ctrl-C, SIGTERM and SIGHUP stop the study through the request yielded.
 
-    They raise :class:`StudyStopped` where Ctrl-C raises ``KeyboardInterrupt``. Only the
-    main thread can take signals; elsewhere this does nothing.
+    Outside a run of this process, a signal raises :class:`StudyStopped` at once; inside
+    one (:func:`~cosim.studies.runner.run_study` hands the request to it), the run ends at
+    its next event boundary, then the request raises it. Only the main thread can take
+    signals; elsewhere the request is never set. A signal ignored when entering (``nohup``)
+    stays ignored.
     """
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = {sig: signal.signal(sig, _raise_stopped) for sig in STOP_SIGNALS}
-    try:
-        yield
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
+    with stopping.stop_on_signals(STOP_SIGNALS, StopRequest(StudyStopped)) as request:
+        yield request
 
 
 def alive(pid: int) -> bool:

@@ -25,7 +25,7 @@ from concurrent.futures import Future, ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
 from multiprocessing import get_context
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import pandas as pd
 
@@ -38,6 +38,9 @@ from cosim.studies.progress import Progress, StudyProgress
 from cosim.studies.spec import StudySpec
 from cosim.studies.worker import Job, Outcome, run_one
 
+if TYPE_CHECKING:
+    from cosim.runner.stopping import StopRequest
+
 BLAS_THREAD_VARIABLES = (
     "OMP_NUM_THREADS",
     "OPENBLAS_NUM_THREADS",
@@ -46,10 +49,10 @@ BLAS_THREAD_VARIABLES = (
 )
 
 
-def _local(jobs: list[Job], workers: int) -> Iterator[Outcome]:
-    if workers <= 1:
+def _local(jobs: list[Job], workers: int, stop: StopRequest | None) -> Iterator[Outcome]:
+    if workers <= 1:  # in this process: a signal only asks its run to stop (see lifeline)
         for job in jobs:
-            yield run_one(job)
+            yield run_one(job, stop=stop)
         return
     # forkserver: workers fork from a clean server that has imported cosim once (fast to
     # start, and nothing inherited from this possibly multi-threaded process)
@@ -107,6 +110,7 @@ def run_study(
     progress: StudyProgress | None = None,
     report: bool = True,
     notify: Callable[[str], None] = _notify,
+    stop: StopRequest | None = None,
 ) -> pd.DataFrame:
     """Run a study and return its results (one row per run).
 
@@ -121,6 +125,9 @@ def run_study(
         report: write figures and report.md when the study has a ``[report]`` section.
         notify: told, a line each, what resuming found (a plan rebuilt, runs run again)
             and the runs the report leaves out of a figure.
+        stop: the stop request of :func:`~cosim.studies.lifeline.stop_on_signals`: a run in
+            this process (one worker) takes a signal as a request to stop at its next event
+            boundary, then the study stops.
 
     Raises:
         ExportError: for a non-empty ``out`` without ``resume``, or a folder that cannot
@@ -147,7 +154,7 @@ def run_study(
         if client is not None:
             outcomes = dask_outcomes(client, jobs, scheduler or "")
         else:
-            outcomes = _local(jobs, workers or os.cpu_count() or 1)
+            outcomes = _local(jobs, workers or os.cpu_count() or 1, stop)
         _write_outcomes(spec, out, outcomes, progress)
     finally:
         if client is not None:
@@ -177,7 +184,7 @@ def _write_outcomes(
         raise type(error)(_kept_message(spec, out, error, _keep(spec, out))) from None
     except KeyboardInterrupt as stop:
         _close(outcomes)
-        signum = stop.signum if isinstance(stop, StudyStopped) else signal.SIGINT
+        signum = getattr(stop, "signum", signal.SIGINT)
         kept = _keep(spec, out)
         raise StudyStopped(
             signum,

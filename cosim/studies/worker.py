@@ -17,6 +17,7 @@ from typing import Any
 from cosim.core.errors import CosimError
 from cosim.runner.execute import execute
 from cosim.runner.result import RECORD_KEYS, RunResult
+from cosim.runner.stopping import StopRequest
 from cosim.scenario import Scenario, load_scenario
 from cosim.scenario.loader import dump_scenario
 
@@ -121,18 +122,27 @@ def failed(
     return Outcome(row, "", {}, {}, failure)
 
 
-def run_one(job: Job) -> Outcome:
+def run_one(job: Job, *, stop: StopRequest | None = None) -> Outcome:
     """Run one study run; failures come back as a row with status ``error``, never raise.
 
     A run that failed once it had started (a plugin's fault, cosim's own, an external
     system's) keeps what ran: its summary of the simulated time reached, its tables and
     its traceback (``failure``), as ``cosim run`` keeps them in a run folder.
+
+    Args:
+        job: the run.
+        stop: the study's stop request, for a run in the study's own process: a signal
+            while the kernel runs ends the run at its next event boundary, then the
+            request raises (the run under way is not kept).
+
+    Raises:
+        KeyboardInterrupt: the study was asked to stop (``stop``'s exception).
     """
     start = time.perf_counter()
     scenario = None
     try:
         scenario = job_scenario(job)
-        result = execute(scenario)
+        result = _execute(scenario, stop)
     except CosimError as error:
         kept = error.kept
         kind = _kind(error)
@@ -151,6 +161,15 @@ def run_one(job: Job) -> Outcome:
             failure=f"internal error: {detail}\n\n{trace}",
         )
     return _outcome(job, result, dump_scenario(scenario), "", "", "")
+
+
+def _execute(scenario: Scenario, stop: StopRequest | None) -> RunResult:
+    """:func:`execute`, then the stop asked for during the run, if any (whatever it gave)."""
+    try:
+        return execute(scenario, stop=stop)
+    finally:
+        if stop is not None:
+            stop.raise_if_requested()
 
 
 def _kind(error: CosimError) -> str:

@@ -57,7 +57,9 @@ class Scripted(PolledSource):
         return {"mocap_scripted_polls": len(self.polls)}
 
 
-def scripted(timeout_s: float = 0.5, rate_hz: float = 10.0) -> tuple[RunContext, Scripted, list]:
+def scripted(
+    timeout_s: float = 0.5, rate_hz: float = 10.0, duration_s: float = 300.0
+) -> tuple[RunContext, Scripted, list]:
     """A source tracking robot_1 and robot_3, polled at ``rate_hz``, started at time 0."""
     s = cosim.load_scenario(
         "warehouse-random",
@@ -66,6 +68,7 @@ def scripted(timeout_s: float = 0.5, rate_hz: float = 10.0) -> tuple[RunContext,
             "mocap.source": "simulated",
             "mocap.connect_timeout_s": timeout_s,
             "mocap.rate_hz": rate_hz,
+            "scenario.duration_s": duration_s,
         },
     )
     assembly = assemble(s)
@@ -165,7 +168,7 @@ def test_closing_takes_the_counts_and_disconnects_once():
     source.close()
     source.close()
     assert source.disconnects == 1
-    assert source.summary() == {"mocap_scripted_polls": 3}
+    assert source.summary() == {"mocap_connected": False, "mocap_scripted_polls": 3}
 
 
 def test_closing_a_source_that_never_started_does_nothing():
@@ -183,3 +186,36 @@ def test_a_subclass_must_say_what_arrived_and_what_it_listened_for():
     with pytest.raises(NotImplementedError):
         bare.silence(0)
     assert bare.failure() is None and bare.counts() == {}
+
+
+@pytest.mark.parametrize("timeout_s", [10.0, 1.0])
+def test_a_run_ending_within_the_timeout_with_a_silent_robot_fails_at_its_last_poll(timeout_s):
+    run, source, _ = scripted(timeout_s=timeout_s, duration_s=1.0)
+    source.arrivals[100_000_000] = [(0, 90_000_000, 2.0, 2.0, 0.0)]
+    run.kernel.run(900_000_000)  # the polls up to 0.8 s: still waiting
+    with pytest.raises(LiveSourceError) as ended:
+        run.kernel.run(1_000_000_000)
+    assert str(ended.value) == (
+        "nothing of robot_3 from the scripted system; the run ended at 1 s, within "
+        f"mocap.connect_timeout_s = {timeout_s:g} s: expected a pose of every tracked robot "
+        "before the run ends (see mocap.bodies and the scripted system)"
+    )
+    assert events(run) == [
+        (0.9, "robot_3", "no_pose", "nothing of robot_3 from the scripted system")
+    ]
+    assert source.waited_s == 1.0  # what a source's silence() says it waited
+    source.close()
+    assert source.summary()["mocap_connected"] is True  # robot_1 was heard
+
+
+def test_a_run_ending_within_the_timeout_whose_robots_were_all_heard_ends_as_planned():
+    run, source, _ = scripted(timeout_s=10.0, duration_s=1.0)
+    source.arrivals[500_000_000] = [(0, 0, 2.0, 2.0, 0.0), (2, 0, 4.0, 1.0, 1.0)]
+    run.kernel.run(1_000_000_000)
+    assert len(source.polls) == 10 and events(run) == []
+    assert source.waited_s == 1.0
+
+
+def test_a_run_longer_than_the_timeout_waits_the_timeout():
+    _, source, _ = scripted(timeout_s=0.5, duration_s=1.0)
+    assert source.waited_s == 0.5

@@ -144,3 +144,31 @@ def test_ctrl_c_while_waiting_for_a_mocap_server_stops_the_run_at_once_keeping_w
     assert err.startswith("cosim: stopped by SIGINT at ") and err.count("\n") == 1
     assert (out / "tables" / "mocap.parquet").is_file()
     assert not [w for w in workers() if "127.0.0.1" in w]
+
+
+@pytest.mark.slow
+def test_a_run_shorter_than_the_timeout_that_never_connects_fails_in_one_line_keeping_results(
+    tmp_path: Path,
+):
+    out = tmp_path / "run"
+    done = cosim_main(
+        "run", "lab-room", "--duration-s", "1", "--quiet",
+        "--set", "mocap.source=motioncapture", "--set", 'mocap.bodies=[["robot_1","jackal"]]',
+        "--set", "mocap.system=vicon", "--set", "mocap.hostname=127.0.0.1",
+        "--out", str(out),
+    )  # fmt: skip
+    assert done.returncode == 2  # as when the timeout passes: a live run without poses failed
+    failed = (
+        "the vicon motion capture at '127.0.0.1' did not answer within 1 s (no connection); the "
+        "run ended at 1 s, within mocap.connect_timeout_s = 10 s: expected a pose of every "
+        "tracked robot before the run ends (see mocap.system, mocap.hostname and mocap.bodies)"
+    )
+    summary = json.loads((out / "summary.json").read_text())
+    assert done.stderr == (
+        f"cosim: error: {failed}; the results of the {summary['sim_time_s']:g} s simulated are "
+        f'in {out}/ (summary.json says "failed")\n'
+    )
+    assert summary["failed"] == failed and summary["failure"] == {"kind": "external"}
+    assert summary["mocap_connected"] is False and summary["mocap_poses"] == 0
+    assert 0.9 <= summary["sim_time_s"] < 1.0  # its last poll
+    assert (out / "tables" / "mocap.parquet").is_file()

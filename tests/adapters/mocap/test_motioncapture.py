@@ -235,4 +235,4 @@ def test_closing_counts_the_bodies_never_seen_and_ends_the_feed(monkeypatch):
     source.close()
     source.close()
     assert feed.closed == 1
-    assert source.summary() == {"mocap_missing_bodies": 1}
+    assert source.summary() == {"mocap_connected": False, "mocap_missing_bodies": 1}

@@ -173,3 +173,65 @@ def test_read_next_takes_the_following_frames_payload_and_counts_it():
     with pytest.raises(framing.FrameError, match="connection closed before a service payload"):
         scene.connection.read_next()
     scene.connection.conn.close()
+
+
+def test_a_frame_the_handler_fails_on_otherwise_ends_that_connection_in_one_line(
+    monkeypatch, caplog
+):
+    died: list[threading.ExceptHookArgs] = []
+    monkeypatch.setattr(threading, "excepthook", died.append)
+
+    def overflow(client: Connection, destination: str, payload: bytes) -> None:
+        raise RecursionError("maximum recursion depth exceeded\nwhile decoding")
+
+    scene = Scene(overflow)
+    scene.connection.peer = "127.0.0.1:5000"
+    scene.connection.start()
+    try:
+        scene.unity.sendall(framing.frame("__subscribe", b"[[[["))
+        text = json.loads(scene.until("__error"))["text"]
+        assert text == (
+            "cosim: cannot handle a frame (RecursionError: maximum recursion depth exceeded "
+            "while decoding); closing the connection"
+        )
+        assert framing.read_frame(scene.unity) is None  # closed after the error went out
+        assert scene.connection.closed.wait(5.0)
+        scene.connection.join()
+    finally:
+        scene.connection.stop()
+        scene.unity.close()
+    assert died == []  # the reader thread ended as it does on a clean close
+    assert scene.sink.counts["unity_frames_rejected"] == 1
+    assert caplog.messages == [
+        "unity: refused a frame from 127.0.0.1:5000: cannot handle a frame (RecursionError: "
+        "maximum recursion depth exceeded while decoding); closing the connection"
+    ]
+
+
+def test_the_first_refusals_of_a_connection_are_logged_naming_the_peer_the_rest_counted(caplog):
+    def refuse(client: Connection, destination: str, payload: bytes) -> None:
+        raise ValueError(f"{destination!r} is not a topic of this run")
+
+    scene = Scene(refuse)
+    scene.connection.peer = "[::1]:6000"
+    scene.connection.start()
+    try:
+        count = connection.LOGGED_REFUSALS + 3
+        scene.unity.sendall(b"".join(framing.frame(f"/t{k}", b"") for k in range(count)))
+        for _ in range(count):
+            scene.until("__error")
+    finally:
+        scene.connection.stop()
+        scene.connection.join()
+        scene.unity.close()
+    assert scene.sink.counts["unity_frames_rejected"] == count
+    assert len(caplog.records) == connection.LOGGED_REFUSALS
+    assert {r.levelname for r in caplog.records} == {"WARNING"}
+    assert (
+        caplog.messages[0]
+        == "unity: refused a frame from [::1]:6000: '/t0' is not a topic of this run"
+    )
+    assert caplog.messages[-1].endswith(
+        f"'/t{connection.LOGGED_REFUSALS - 1}' is not a topic of this run; its further refusals "
+        "are only counted"
+    )

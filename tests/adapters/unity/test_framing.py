@@ -12,7 +12,9 @@ from hypothesis import strategies as st
 
 from adapters.unity.framing import (
     KEEPALIVE,
+    MAX_COMMAND_BYTES,
     MAX_DESTINATION_BYTES,
+    MAX_JSON_DEPTH,
     MAX_PAYLOAD_BYTES,
     VERSION,
     FrameError,
@@ -20,6 +22,7 @@ from adapters.unity.framing import (
     error,
     frame,
     handshake,
+    json_depth,
     parse_json,
     read_frame,
     text_field,
@@ -199,3 +202,78 @@ def test_any_command_payload_is_a_json_object_or_refused_with_a_value_error(payl
         assert str(problem).startswith("__publish: ")
         return
     assert isinstance(value, dict)
+
+
+@pytest.mark.parametrize(
+    ("text", "depth"),
+    [
+        (b'{"topic": "/a", "message_name": "std_msgs/String"}', 1),
+        (b"3", 0),
+        (b'{"a": [1, {"b": "[[[{{{"}]}', 3),
+        (b'["a\\"]", "]]"]', 1),  # an escaped quote does not end the string
+        (b"[" * 5000, 5000),  # unbalanced: counted as it opens
+        (b'["unterminated [[[', 1),  # a string running to the end hides its brackets
+        (b"", 0),
+    ],
+)
+def test_the_depth_of_json_counts_arrays_and_objects_not_brackets_in_strings(text, depth):
+    assert json_depth(text) == depth
+
+
+def test_json_nested_deeper_than_allowed_is_refused_naming_the_command_and_the_depth():
+    deep = b'{"topic": ' * 40 + b'"/a"' + b"}" * 40
+    with pytest.raises(ValueError) as refused:
+        parse_json("__subscribe", deep)
+    assert str(refused.value) == (
+        f"__subscribe: JSON nested 40 levels deep; expected at most {MAX_JSON_DEPTH} "
+        "(a command is a flat object)"
+    )
+    deepest = b'{"a": ' * MAX_JSON_DEPTH + b"1" + b"}" * MAX_JSON_DEPTH + b"\x00"
+    assert json_depth(deepest) == MAX_JSON_DEPTH and "a" in parse_json("__publish", deepest)
+
+
+def test_json_deep_enough_to_exhaust_pythons_parser_is_refused_as_too_deep():
+    with pytest.raises(RecursionError):  # what the reader thread died of
+        json.loads("[" * 30_000 + "]" * 30_000)
+    with pytest.raises(ValueError, match=r"^__subscribe: JSON nested 30000 levels deep; "):
+        parse_json("__subscribe", b"[" * 30_000 + b"]" * 30_000)
+
+
+def test_a_command_larger_than_allowed_is_refused_naming_its_size():
+    big = json.dumps({"topic": "/a" * MAX_COMMAND_BYTES}).encode()
+    with pytest.raises(ValueError) as refused:
+        parse_json("__publish", big)
+    assert str(refused.value) == (
+        f"__publish: a JSON payload of {len(big)} bytes; expected at most {MAX_COMMAND_BYTES} "
+        "(a command is a small flat object)"
+    )
+
+
+def test_a_number_too_long_for_python_is_refused_as_not_json_in_one_line():
+    with pytest.raises(ValueError, match=r"^__subscribe: the payload is not JSON \(") as refused:
+        parse_json("__subscribe", b'{"queue_size": ' + b"9" * 5000 + b"}")
+    assert "\n" not in str(refused.value)
+
+
+JSON_VALUES = st.recursive(
+    st.none() | st.booleans() | st.integers() | st.floats() | st.text(max_size=10),
+    lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=5), inner),
+    max_leaves=30,
+)
+DEEP_JSON = st.builds(
+    lambda depth, opener, closed: opener * depth + (b"]" * depth if closed else b""),
+    st.integers(1, 20_000),
+    st.sampled_from([b"[", b'{"a":', b'[{"b": "]"}, ']),
+    st.booleans(),
+)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.one_of(JSON_VALUES.map(lambda v: json.dumps(v).encode()), DEEP_JSON, st.binary()))
+def test_any_json_or_bytes_is_a_command_object_or_refused_in_one_line_naming_the_command(payload):
+    try:
+        value = parse_json("__subscribe", payload)
+    except ValueError as problem:
+        assert str(problem).startswith("__subscribe: ") and "\n" not in str(problem)
+        return
+    assert isinstance(value, dict) and json_depth(payload) <= MAX_JSON_DEPTH

@@ -6,6 +6,7 @@ import json
 import math
 import socket
 import struct
+import threading
 from collections.abc import Iterator
 from typing import Any
 
@@ -14,6 +15,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from adapters.unity import framing
 from adapters.unity.inbound import UnityGoal
 from adapters.unity.server import UnityOptions, UnitySink
 from cosim.core.bus import Bus, TopicQos
@@ -267,4 +269,86 @@ def test_bytes_that_break_the_framing_close_that_connection_only(raw: bytes) -> 
         client.sock.sendall(raw)
         assert _round_trip(served.client())["topics"]  # another scene is served as before
     finally:
+        served.sink.close()
+
+
+def test_a_deeply_nested_subscribe_is_refused_in_one_line_and_the_connection_goes_on(
+    served: Served, caplog: pytest.LogCaptureFixture, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    died: list[Any] = []
+    monkeypatch.setattr(threading, "excepthook", died.append)
+    client = served.client()
+    nested = b'{"topic": ' * 30_000 + b'"/robot_1/scan"' + b"}" * 30_000
+    client.sock.sendall(connector_string("__subscribe") + struct.pack("<I", len(nested)))
+    client.sock.sendall(nested)
+    text = json.loads(client.until("__error"))["text"]
+    assert text == (
+        "cosim: __subscribe: a JSON payload of 330015 bytes; expected at most 65536 "
+        "(a command is a small flat object)"
+    )
+    deep = b"[" * 20_000 + b"]" * 20_000  # under the size limit, past Python's parser
+    client.sock.sendall(connector_string("__subscribe") + struct.pack("<I", len(deep)) + deep)
+    text = json.loads(client.until("__error"))["text"]
+    assert text == (
+        "cosim: __subscribe: JSON nested 20000 levels deep; expected at most 32 "
+        "(a command is a flat object)"
+    )
+    assert "/robot_1/scan" in _round_trip(client)["topics"]  # the same connection serves on
+    peer = f"127.0.0.1:{client.sock.getsockname()[1]}"
+    assert caplog.messages[-1] == (
+        f"unity: refused a frame from {peer}: __subscribe: JSON nested 20000 levels deep; "
+        "expected at most 32 (a command is a flat object)"
+    )
+    assert served.sink.summary()["unity_frames_rejected"] == 2 and died == []
+
+
+NESTED = st.builds(
+    lambda depth, opener, closed: opener * depth + (b"]" * depth if closed else b""),
+    st.integers(1, 40_000),
+    st.sampled_from([b"[", b'{"topic":', b'[{"a": "]"}, ', b'{"a": [']),
+    st.booleans(),
+)
+JSON_VALUES = st.recursive(
+    st.none() | st.booleans() | st.integers() | st.floats() | st.text(max_size=12),
+    lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=8), inner),
+    max_leaves=20,
+).map(lambda v: json.dumps(v).encode())
+INBOUND = st.one_of(st.binary(max_size=300), NESTED, JSON_VALUES, PAYLOADS)
+COMMANDS = ["__subscribe", "__publish", "__topic_list", "__remove_subscriber",
+            "__remove_publisher", "__ros_service", "__request", "__response"]  # fmt: skip
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    st.lists(
+        st.tuples(
+            st.one_of(st.sampled_from([*COMMANDS, "/robot_1/goal_pose"]), st.text(max_size=30)),
+            INBOUND,
+        ),
+        min_size=1,
+        max_size=6,
+    )
+)
+def test_whatever_a_scene_sends_in_well_formed_frames_its_connection_is_answered_and_served_on(
+    frames: list[tuple[str, bytes]],
+) -> None:
+    """Random bytes and JSON nested at random depths, to commands and to a goal topic."""
+    died: list[Any] = []
+    before, threading.excepthook = threading.excepthook, died.append
+    served = Served()
+    try:
+        client = served.client()
+        client.command(
+            "__publish",
+            {"topic": "/robot_1/goal_pose", "message_name": "geometry_msgs/PoseStamped"},
+        )
+        for destination, payload in frames:
+            client.sock.sendall(connector_string(destination) + struct.pack("<I", len(payload)))
+            client.sock.sendall(payload + framing.KEEPALIVE)  # what __request takes as its own
+        assert "/robot_1/scan" in _round_trip(client)["topics"]  # this connection still serves
+        assert died == []
+        served.kernel.run(100_000_000)
+        assert all(math.isfinite(getattr(goal, "x_m", math.nan)) for goal in served.goals)
+    finally:
+        threading.excepthook = before
         served.sink.close()

@@ -9,7 +9,16 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from cosim.cli.hostname import EXPECTED, NAME_CHARS, check_live_host, host_argument, is_host
+from cosim.cli.hostname import (
+    EXPECTED,
+    NAME_CHARS,
+    Listener,
+    check_live_host,
+    check_ports,
+    host_argument,
+    is_host,
+    run_listeners,
+)
 from cosim.core.errors import ConfigError
 
 
@@ -111,3 +120,69 @@ def test_a_name_that_does_not_resolve_is_refused_naming_the_flag_value_and_reaso
         "--live-host 'no-such-host.invalid': cannot resolve it (Name or service not known); "
         f"expected {EXPECTED}"
     )
+
+
+def _server(host: str, port: int) -> socket.socket:
+    family = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)[0][0]
+    return socket.create_server((host, port), family=family)  # as the Unity endpoint binds
+
+
+@pytest.mark.parametrize(
+    ("first", "second"),
+    [
+        ("127.0.0.1", "127.0.0.1"),
+        ("127.0.0.1", "localhost"),
+        ("0.0.0.0", "127.0.0.1"),
+        ("127.0.0.1", "0.0.0.0"),
+        ("127.0.0.1", "127.0.0.2"),
+        ("127.0.0.1", "::1"),
+        ("::1", "::1"),
+    ],
+)
+def test_two_servers_on_one_port_are_refused_exactly_when_the_second_could_not_listen(
+    first, second
+):
+    with _server(first, 0) as taken:
+        port = taken.getsockname()[1]
+        try:
+            _server(second, port).close()
+            clash = False
+        except OSError:
+            clash = True
+    one = Listener("the live view", "--live-port", first, port)
+    other = Listener("the Unity endpoint", "--unity-port", second, port)
+    if not clash:
+        check_ports(one, other)
+        return
+    with pytest.raises(ConfigError) as refused:
+        check_ports(one, other)
+    where = f"on {first}" if first == second else f"on {first} and {second}"
+    assert str(refused.value) == (
+        f"--live-port {port} and --unity-port {port} name the same port: the live view and "
+        f"the Unity endpoint cannot both listen on it ({where}); expected two different ports "
+        "(0: any free one)"
+    )
+
+
+def test_port_0_is_any_free_port_for_each_server_and_different_ports_never_clash():
+    check_ports(Listener("a", "--a-port", "0.0.0.0", 0), Listener("b", "--b-port", "0.0.0.0", 0))
+    check_ports(Listener("a", "--a-port", "0.0.0.0", 1), Listener("b", "--b-port", "0.0.0.0", 2))
+    check_ports(Listener("a", "--a-port", "127.0.0.1", 5))  # one server alone
+
+
+def test_every_interface_of_ipv6_counts_as_taking_ipv4_too():
+    with pytest.raises(ConfigError, match=r"^--a-port 9 and --b-port 9 name the same port"):
+        check_ports(Listener("a", "--a-port", "::", 9), Listener("b", "--b-port", "127.0.0.1", 9))
+
+
+@pytest.mark.parametrize(
+    ("live", "unity"), [(True, True), (True, False), (False, True), (False, False)]
+)
+def test_the_servers_of_a_run_are_those_its_flags_turn_on(live, unity):
+    args = argparse.Namespace(
+        live=live, live_host="0.0.0.0", live_port=9, unity=unity, unity_host="::1", unity_port=9
+    )
+    expected = [Listener("the live view", "--live-port", "0.0.0.0", 9)] * live + [
+        Listener("the Unity endpoint", "--unity-port", "::1", 9)
+    ] * unity
+    assert run_listeners(args) == expected

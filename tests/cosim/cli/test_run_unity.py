@@ -133,3 +133,21 @@ def test_a_bad_unity_host_is_one_line_naming_it(host: str, expected: str, tmp_pa
     assert done.returncode == 2
     assert expected in done.stderr
     assert "Traceback" not in done.stderr
+
+
+def test_one_port_for_the_live_view_and_unity_is_one_line_naming_both_flags(
+    tmp_path: Path,
+) -> None:
+    with socket.create_server(("127.0.0.1", 0)) as probe:
+        port = probe.getsockname()[1]  # free once closed: nothing else is blamed
+    done = cosim_main(
+        "run", "lab-room", "--live", "--unity", "--live-port", str(port), "--unity-port",
+        str(port), "--duration-s", "0.1", "--out", str(tmp_path / "run"),
+    )  # fmt: skip
+    assert done.returncode == 2
+    assert done.stderr == (
+        f"cosim: error: --live-port {port} and --unity-port {port} name the same port: the "
+        "live view and the Unity endpoint cannot both listen on it (on 127.0.0.1); expected "
+        "two different ports (0: any free one)\n"
+    )
+    assert not (tmp_path / "run").exists()

@@ -1,6 +1,8 @@
 """A study's processes live and stop with it (cosim.studies.lifeline), in real processes."""
 
+import json
 import os
+import random
 import signal
 import subprocess
 import sys
@@ -13,6 +15,8 @@ import pytest
 
 from cosim.studies.lifeline import STUDY_PID_VARIABLE, StudyStopped, signal_name, stop_on_signals
 from tests.conftest import cosim_main
+from tests.cosim.studies.busy import SHORT_RUN as BUSY_SHORT_RUN
+from tests.cosim.studies.busy import busy_study
 from tests.cosim.studies.small import finished, small_study
 
 # two short runs, then two long ones: a signal sent once the short ones are written lands
@@ -155,3 +159,66 @@ def test_a_fork_server_whose_study_is_gone_leaves_at_once(study, stays):
     )
     assert done.returncode == 0, done.stderr
     assert (done.stdout == "stayed\n") is stays
+
+
+TRIALS = 30
+"""Studies stopped by SIGTERM, each while its long run measures clearances with FCL."""
+
+
+@pytest.mark.slow
+def test_sigterm_at_any_moment_of_collision_checking_stops_the_study_every_time(tmp_path):
+    """A signal that lands inside FCL's callbacks is never lost (it was one time in three)."""
+    study = busy_study(tmp_path)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "tests.cosim.studies.busy", str(study), str(tmp_path), str(TRIALS)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    assert proc.stdout is not None
+    moments = random.Random(43)
+    outcomes = []
+    try:
+        for trial in range(TRIALS):
+            started = proc.stdout.readline().split()
+            assert started[:2] == ["start", str(trial)], (started, proc.stderr.read())
+            out = Path(started[2])
+            deadline = time.monotonic() + 60
+            while BUSY_SHORT_RUN not in finished(out):  # the long run starts now
+                assert time.monotonic() < deadline, "the short run did not finish in 60 s"
+                time.sleep(0.005)
+            time.sleep(moments.uniform(0.15, 0.6))  # the long run is in its steps by then
+            proc.send_signal(signal.SIGTERM)
+            outcomes.append((out, json.loads(proc.stdout.readline())))
+    finally:
+        proc.kill()
+        proc.communicate()
+    lost = [done["trial"] for _out, done in outcomes if done["status"] != 143]
+    swallowed = [done["trial"] for _out, done in outcomes if "Exception ignored" in done["stderr"]]
+    assert not lost, f"{len(lost)} of {TRIALS} signals lost: trials {lost} ({swallowed} by FCL)"
+    for out, done in outcomes:
+        assert done["stderr"] == (
+            f"cosim: busy: stopped by SIGTERM; the 1 finished runs are kept in {out}: "
+            "continue with --resume\n"
+        )
+        kept = pd.read_parquet(out / "results.parquet")
+        assert list(kept["run_id"]) == [BUSY_SHORT_RUN] and list(kept["status"]) == ["ok"]
+        assert finished(out) == [BUSY_SHORT_RUN] and not list((out / "runs").glob("*.partial"))
+
+
+def test_inside_a_run_of_the_study_process_a_signal_is_noted_and_raised_where_it_is_looked_for():
+    with stop_on_signals() as request:
+        with request.deferred():  # as while a run's kernel goes
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(0.01)  # the handler has run: nothing was raised
+            assert request.signum == signal.SIGTERM
+        with pytest.raises(StudyStopped) as stopped:
+            request.raise_if_requested()
+    assert stopped.value.signum == signal.SIGTERM
+
+
+def test_ctrl_c_stops_a_study_as_sigterm_does():
+    with pytest.raises(StudyStopped) as stopped, stop_on_signals():
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(1)
+    assert stopped.value.signum == signal.SIGINT and stopped.value.exit_status == 130

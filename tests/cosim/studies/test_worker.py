@@ -2,9 +2,15 @@
 
 import io
 import json
+import os
+import signal
+import threading
+import time
 
 import pandas as pd
+import pytest
 
+from cosim.studies.lifeline import StudyStopped, stop_on_signals
 from cosim.studies.worker import Job, failed, job_scenario, row_cells, run_one, run_overrides
 
 
@@ -66,3 +72,19 @@ def test_a_failed_outcome_keeps_the_jobs_cells_and_the_time_it_took():
     assert outcome.row["run_id"] == "r0" and outcome.row["robots.count"] == 2
     assert outcome.row["status"] == "error" and outcome.row["error"] == "it broke"
     assert outcome.row["wall_time_s"] == 1.2346
+
+
+def test_a_signal_during_a_run_of_the_study_process_ends_the_run_then_stops_the_study():
+    sender = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGTERM))
+    started = time.monotonic()
+    with pytest.raises(StudyStopped) as stopped, stop_on_signals() as request:
+        sender.start()
+        run_one(_job(duration_s=1e5), stop=request)  # hours of wall time, left to run
+    assert stopped.value.signum == signal.SIGTERM
+    assert time.monotonic() - started < 30  # stopped at an event boundary, not at the end
+
+
+def test_a_study_asked_to_stop_starts_no_run():
+    with pytest.raises(StudyStopped), stop_on_signals() as request:
+        request.signum = signal.SIGHUP
+        run_one(_job(), stop=request)
