@@ -209,7 +209,7 @@ def test_sigterm_at_any_moment_of_collision_checking_stops_the_study_every_time(
 def test_inside_a_run_of_the_study_process_a_signal_is_noted_and_raised_where_it_is_looked_for():
     with stop_on_signals() as request:
         with request.deferred():  # as while a run's kernel goes
-            os.kill(os.getpid(), signal.SIGTERM)
+            signal.raise_signal(signal.SIGTERM)
             time.sleep(0.01)  # the handler has run: nothing was raised
             assert request.signum == signal.SIGTERM
         with pytest.raises(StudyStopped) as stopped:
@@ -219,6 +219,6 @@ def test_inside_a_run_of_the_study_process_a_signal_is_noted_and_raised_where_it
 
 def test_ctrl_c_stops_a_study_as_sigterm_does():
     with pytest.raises(StudyStopped) as stopped, stop_on_signals():
-        os.kill(os.getpid(), signal.SIGINT)
+        signal.raise_signal(signal.SIGINT)
         time.sleep(1)
     assert stopped.value.signum == signal.SIGINT and stopped.value.exit_status == 130
