@@ -6,13 +6,19 @@ The folder::
     runs/<run_id>/      row.json, summary.json, scenario.toml[, tables/*.parquet]
     results.parquet     one row per run
 
-A run's folder appears at once, complete (written beside it, then renamed). ``--resume``
+A run's folder appears at once, complete (:mod:`cosim.studies.writing`). ``--resume``
 continues only the study that started the folder: the same runs (seeds, overrides,
 duration, tables) of the same resolved scenario and the same files it reads
 (:func:`fingerprint`). If ``plan.json`` is lost or garbled, the finished runs are the
 evidence: each one's row and ``scenario.toml`` must be what this study would run, and then
 the plan is written again. A run whose ``row.json`` cannot be read, or is not the planned
 run's (its seed or an override differs), is run again.
+
+Run folders of every earlier format are read (:mod:`cosim.runner.runfolder`): a key
+renamed since with its meaning kept (:data:`cosim.scenario.migrations.RENAMES`) is the
+same setting, so a finished run whose ``scenario.toml`` differs from today's only by such
+names is resumed, with a note; a rename whose model changed too is a changed scenario,
+named as such.
 """
 
 from __future__ import annotations
@@ -20,20 +26,20 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import shutil
+import tomllib
 from collections.abc import Iterator
 from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any
 
-import pandas as pd
-
 from cosim.core.errors import ConfigError, ExportError
-from cosim.runner.faults import FAILURE_FILE
+from cosim.runner.runfolder import folder_format, read_run_scenario
 from cosim.scenario import Scenario, load_scenario
+from cosim.scenario.fields import show_value
 from cosim.scenario.loader import dump_scenario
+from cosim.scenario.migrations import migrate, migrate_dotted
 from cosim.studies.spec import RunSpec, StudySpec
-from cosim.studies.worker import Job, Outcome, job_scenario, row_cells, run_overrides
+from cosim.studies.worker import Job, job_scenario, row_cells, run_overrides
 
 PLAN_FILE = "plan.json"
 RUNS_DIR = "runs"
@@ -41,6 +47,7 @@ ROW_FILE = "row.json"
 SCENARIO_FILE = "scenario.toml"
 RESULTS_FILE = "results.parquet"
 PARTIAL = ".partial"
+"""What the folders of runs on their way ended with before format 1 (never read)."""
 CHUNK = 1 << 20
 
 
@@ -57,6 +64,20 @@ class FolderState:
     done: frozenset[str]
     notes: tuple[str, ...]
     plan: str
+
+
+@dataclass(frozen=True)
+class _Compared:
+    """A finished run's ``scenario.toml`` against what the study would run now.
+
+    Attributes:
+        change: ``""`` the same (its keys read under today's names), the first difference,
+            or None when the file cannot be read.
+        notes: one line per key of the file read under its new name.
+    """
+
+    change: str | None
+    notes: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -187,9 +208,15 @@ def _run_folders(out: Path) -> dict[str, _Found]:
     if not runs.is_dir():
         return {}
     try:
-        folders = [p for p in runs.iterdir() if p.is_dir() and not p.name.endswith(PARTIAL)]
+        folders = [
+            p
+            for p in runs.iterdir()
+            if p.is_dir() and not p.name.startswith(".") and not p.name.endswith(PARTIAL)
+        ]
     except OSError as error:
         raise ExportError(f"{runs}: cannot read the study's runs ({_reason(error)})") from None
+    for folder in folders:  # a run of a newer format than this cosim reads stops the resume
+        folder_format(folder)
     return {p.name: read_row(p / ROW_FILE) for p in sorted(folders)}
 
 
@@ -239,7 +266,7 @@ def inspect(spec: StudySpec, out: Path, *, resume: bool) -> FolderState:
         what = f"the study's runs changed ({difference})"
         raise ConfigError(_changed(spec, out, what, finished))
     if old is not None and isinstance(old.get("fingerprint"), dict):
-        _check_fingerprint(spec, out, old["fingerprint"], plan["fingerprint"], finished)
+        notes += _check_fingerprint(spec, out, old["fingerprint"], plan["fingerprint"], finished)
         done = set()
         for run_id in (r for r in finished if r in planned):
             if bad := _unlike(finished[run_id], row_cells(job_of(spec, planned[run_id]))):
@@ -275,7 +302,7 @@ def _plan_difference(old: dict[str, Any], new: dict[str, Any]) -> str:
     for key in ("scenario", "duration_s", "tables"):
         if key in old and _canonical(old[key]) != _canonical(new[key]):
             return f"{key} {_canonical(old[key])} then, {_canonical(new[key])} now"
-    then = {str(r.get("run_id")): r for r in old["runs"] if isinstance(r, dict)}
+    then = {str(r.get("run_id")): _renamed_run(r) for r in old["runs"] if isinstance(r, dict)}
     now = {r["run_id"]: r for r in new["runs"]}
     if set(then) != set(now):
         gone, added = sorted(set(then) - set(now)), sorted(set(now) - set(then))
@@ -286,6 +313,12 @@ def _plan_difference(old: dict[str, Any], new: dict[str, Any]) -> str:
         if _canonical(before) != _canonical(run):
             return _run_difference(run_id, before, run)
     return ""
+
+
+def _renamed_run(run: dict[str, Any]) -> dict[str, Any]:
+    """A planned run of ``plan.json`` with its overrides' keys under today's names."""
+    overrides = run.get("overrides")
+    return {**run, "overrides": migrate_dotted(overrides)} if isinstance(overrides, dict) else run
 
 
 def _run_difference(run_id: str, before: dict[str, Any], now: dict[str, Any]) -> str:
@@ -305,46 +338,74 @@ def _check_fingerprint(
     old: dict[str, Any],
     new: dict[str, Any],
     finished: dict[str, Any],
-) -> None:
+) -> list[str]:
+    """Refuse a folder whose runs depend on other files or another scenario; notes.
+
+    A fingerprint that differs only because keys were renamed since (every finished run's
+    ``scenario.toml`` is today's once its keys are read under their new names) is no
+    change: the notes say which keys.
+
+    Raises:
+        ConfigError: a file the scenario reads, or the scenario itself, changed.
+    """
     files = old.get("files", {})
     for name, digest in new["files"].items():
         if isinstance(files, dict) and files.get(name, digest) != digest:
             what = f"{name} (a file the scenario reads) changed"
             raise ConfigError(_changed(spec, out, what, finished))
-    if old.get("scenario") != new["scenario"]:
-        where = _first_scenario_change(spec, out, finished)
-        raise ConfigError(
-            _changed(spec, out, f"the scenario {spec.scenario} changed{where}", finished)
-        )
-
-
-def _first_scenario_change(spec: StudySpec, out: Path, finished: dict[str, Any]) -> str:
-    """`` (run R: `line` then, `line` now)`` from the first finished run, or ""."""
+    if old.get("scenario") == new["scenario"]:
+        return []
     planned = {r.run_id: r for r in spec.runs()}
-    for run_id in finished:
-        if run_id in planned:
-            change = _scenario_change(spec, out, planned[run_id])
-            if change:
-                return f" (run {run_id}: {change})"
-    return ""
+    compared = {r: _scenario_change(spec, out, planned[r]) for r in finished if r in planned}
+    renamed = [note for c in compared.values() for note in c.notes]
+    if compared and renamed and all(c.change == "" for c in compared.values()):
+        return [
+            f"{out / PLAN_FILE}: the scenario differs from the plan's only by keys renamed "
+            "since; resuming",
+            *dict.fromkeys(renamed),
+        ]
+    where = next((f" (run {run_id}: {c.change})" for run_id, c in compared.items() if c.change), "")
+    raise ConfigError(_changed(spec, out, f"the scenario {spec.scenario} changed{where}", finished))
 
 
-def _scenario_change(spec: StudySpec, out: Path, run: RunSpec) -> str | None:
+def _scenario_change(spec: StudySpec, out: Path, run: RunSpec) -> _Compared:
     """How a finished run's ``scenario.toml`` differs from what the study runs now.
 
-    Returns:
-        "" when they are the same, the first differing line when not, None when the run
-        has no readable ``scenario.toml``.
+    Keys renamed since are read under their new names first: a rename that kept the
+    meaning is no difference (it is noted), one whose model changed is the difference.
     """
+    folder = out / RUNS_DIR / run.run_id
     try:
-        then = (out / RUNS_DIR / run.run_id / SCENARIO_FILE).read_text(encoding="utf-8")
+        then = (folder / SCENARIO_FILE).read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError):
-        return None
+        return _Compared(None)
     now = dump_scenario(job_scenario(job_of(spec, run)))
     if then == now:
-        return ""
+        return _Compared("")
+    try:
+        raw = tomllib.loads(then)
+        applied = migrate(raw, str(folder / SCENARIO_FILE)).applied
+        old = read_run_scenario(folder)
+    except (tomllib.TOMLDecodeError, ConfigError, ExportError):
+        return _Compared(_first_difference(then, now))
+    for rename in applied:
+        if not rename.same_meaning:
+            section, _, key = rename.old.partition(".")
+            value = show_value(raw[section][key])
+            return _Compared(
+                f"{rename.old} = {value} then, renamed {rename.new} in {rename.commit}: "
+                f"{rename.change}"
+            )
+    migrated = dump_scenario(old)
+    if migrated.split("\n", 1)[1:] == now.split("\n", 1)[1:]:  # but the source line
+        return _Compared("", old.notes)
+    return _Compared(_first_difference(migrated, now))
+
+
+def _first_difference(then: str, now: str) -> str:
+    """```line` then, `line` now`` for the first line that differs, or the line counts."""
     old_lines, new_lines = then.splitlines(), now.splitlines()
-    for a, b in zip(old_lines, new_lines, strict=False):
+    for a, b in zip(old_lines[1:], new_lines[1:], strict=False):
         if a != b:
             return f"`{a}` then, `{b}` now"
     return f"{len(old_lines)} lines then, {len(new_lines)} now"
@@ -367,7 +428,8 @@ def _verify(
             raise ConfigError(_changed(spec, out, what, finished))
         if bad := _unlike(row, row_cells(job_of(spec, run))):
             raise ConfigError(_changed(spec, out, f"finished run {run_id} has {bad}", finished))
-        change = _scenario_change(spec, out, run)
+        compared = _scenario_change(spec, out, run)
+        change = compared.change
         if change is None:
             notes.append(
                 f"{out / RUNS_DIR / run_id} has no readable {SCENARIO_FILE} to tell which "
@@ -377,109 +439,18 @@ def _verify(
         if change:
             what = f"the scenario of finished run {run_id} changed ({change})"
             raise ConfigError(_changed(spec, out, what, finished))
+        notes += [note for note in compared.notes if note not in notes]
         done.add(run_id)
     return done, notes
 
 
 def _unlike(row: dict[str, Any], expected: dict[str, Any]) -> str:
-    """``key = value, the study other`` for the first cell of a row unlike the run's, or ""."""
+    """``key = value, the study other`` for the first cell of a row unlike the run's, or "".
+
+    The row's keys are read under today's names (renamed keys of the same meaning).
+    """
+    row = migrate_dotted(row)
     for key, value in expected.items():
         if _canonical(row.get(key)) != _canonical(value):
             return f"{key} = {_canonical(row.get(key))}, the study {_canonical(value)}"
     return ""
-
-
-def _write_text(path: Path, text: str) -> None:
-    """Write ``text`` beside ``path``, then rename: a reader sees the old or the new file."""
-    partial = path.with_name(path.name + PARTIAL)
-    partial.write_text(text, encoding="utf-8")
-    os.replace(partial, path)
-
-
-def prepare(out: Path, state: FolderState) -> None:
-    """Create the folder, write the plan, and clear runs cut short (they run again).
-
-    Raises:
-        ExportError: the folder cannot be written (read-only, full, not a folder).
-    """
-    try:
-        (out / RUNS_DIR).mkdir(parents=True, exist_ok=True)
-        _write_text(out / PLAN_FILE, state.plan)
-        for folder in (out / RUNS_DIR).iterdir():
-            if folder.name.endswith(PARTIAL):
-                shutil.rmtree(folder)
-    except OSError as error:
-        raise ExportError(f"{out}: cannot write the study folder ({_reason(error)})") from None
-
-
-def write_run(out: Path, outcome: Outcome) -> None:
-    """Write a run's folder: complete, or not at all.
-
-    Raises:
-        ExportError: the folder cannot be written (read-only, full).
-    """
-    run_id = outcome.row["run_id"]
-    final = out / RUNS_DIR / run_id
-    partial = out / RUNS_DIR / f"{run_id}{PARTIAL}"
-    try:
-        _write_run_files(partial, outcome)
-        if final.exists():
-            shutil.rmtree(final)  # an earlier failed attempt, or a garbled row
-        os.replace(partial, final)
-    except OSError as error:
-        shutil.rmtree(partial, ignore_errors=True)  # free what it took
-        raise ExportError(f"{out}: cannot write run {run_id} ({_reason(error)})") from None
-
-
-def _write_run_files(partial: Path, outcome: Outcome) -> None:
-    if partial.exists():
-        shutil.rmtree(partial)
-    partial.mkdir(parents=True)
-    if outcome.scenario_toml:
-        (partial / SCENARIO_FILE).write_text(outcome.scenario_toml)
-    if outcome.summary:
-        (partial / "summary.json").write_text(json.dumps(outcome.summary, indent=2) + "\n")
-    if outcome.tables:
-        (partial / "tables").mkdir()
-        for name, data in outcome.tables.items():
-            (partial / "tables" / f"{name}.parquet").write_bytes(data)
-    if outcome.failure:
-        (partial / FAILURE_FILE).write_text(outcome.failure)
-    (partial / ROW_FILE).write_text(json.dumps(outcome.row, indent=1, default=str) + "\n")
-
-
-def finished_rows(spec: StudySpec, out: Path) -> list[dict[str, Any]]:
-    """The readable rows of the study's runs, in plan order."""
-    rows = []
-    for run in spec.runs():
-        found = read_row(out / RUNS_DIR / run.run_id / ROW_FILE)
-        if found.row is not None:
-            rows.append(found.row)
-    return rows
-
-
-def collect(spec: StudySpec, out: Path) -> pd.DataFrame:
-    """Assemble ``results.parquet`` from the run folders, in plan order.
-
-    Raises:
-        ExportError: the results cannot be written (read-only, full).
-    """
-    frame = pd.DataFrame(finished_rows(spec, out))
-    if len(frame):
-        write_results(frame, out / RESULTS_FILE)
-    return frame
-
-
-def write_results(frame: pd.DataFrame, path: Path) -> None:
-    """Write a study's results beside ``path``, then rename: a full disk keeps the old file.
-
-    Raises:
-        ExportError: the results cannot be written (read-only, full).
-    """
-    partial = path.with_name(path.name + PARTIAL)
-    try:
-        frame.to_parquet(partial, index=False)
-        os.replace(partial, path)
-    except OSError as error:
-        partial.unlink(missing_ok=True)
-        raise ExportError(f"{path}: cannot write the results ({_reason(error)})") from None

@@ -13,7 +13,7 @@ import pytest
 
 from cosim.studies.lifeline import STUDY_PID_VARIABLE, StudyStopped, signal_name, stop_on_signals
 from tests.conftest import cosim_main
-from tests.cosim.studies.small import finished, small_study
+from tests.cosim.studies.small import finished, on_its_way, small_study
 
 # two short runs, then two long ones: a signal sent once the short ones are written lands
 # while both workers are inside a long run
@@ -86,7 +86,8 @@ def test_sigterm_stops_a_study_at_once_in_one_line_and_resume_completes_it(tmp_p
     )
     kept = pd.read_parquet(out / "results.parquet")
     assert list(kept["run_id"]) == SHORT_RUNS and set(kept["status"]) == {"ok"}
-    assert finished(out) == SHORT_RUNS and not list((out / "runs").glob("*.partial"))
+    assert finished(out) == SHORT_RUNS
+    assert not [p for p in (out / "runs").iterdir() if on_its_way(p)]
     assert workers and not _running(workers)
     resumed = cosim_main("study", str(path), "--out", str(out), "--workers", "2", "--resume")
     assert resumed.returncode == 0, resumed.stderr
