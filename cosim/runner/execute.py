@@ -151,7 +151,7 @@ def execute(
     result.recorded = session.counts()
     result.summary.update(session.summary())
     if result.failure is not None:
-        if unfinished is not None:
+        if unfinished is not None and not isinstance(result.failure, ExportError):
             result.failure.say_kept(str(unfinished))
         result.failure.kept = result
         raise result.failure
@@ -254,7 +254,7 @@ def _run_assembled(
                 )
     except _HaltError:
         halted, events = True, run.kernel.events_processed - counted
-    except BridgeError as error:  # the real world failed (a silent robot, a mocap server)
+    except (BridgeError, ExportError) as error:  # the world failed: a silent robot, a full disk
         halted, events, failure = True, run.kernel.events_processed - counted, error
     except (Exception, Hung) as error:  # user code, or cosim's: named, and what ran kept
         halted, events = True, run.kernel.events_processed - counted
@@ -345,7 +345,7 @@ def failure_summary(failure: CosimError, planned_s: float, unfinished: list[str]
         kind = "plugin"
     elif isinstance(failure, InternalError):
         kind = "cosim"
-    elif isinstance(failure, BridgeError):
+    elif isinstance(failure, BridgeError | ExportError):
         kind = "external"
     else:
         kind = "input"

@@ -267,7 +267,10 @@ def write_kept(error: CosimError, folder: Path, *, tables: bool) -> None:
     cannot take them, the message says where they are instead (:func:`write_run`).
     """
     kept: RunResult = error.kept
-    details = getattr(error, "details", "")
+    failure = kept.summary.get("failure")
+    details = getattr(error, "details", "") and (
+        isinstance(failure, dict) and failure.get("kind") in ("plugin", "cosim")
+    )  # a traceback tells only of code that failed, not of a full disk or a silent robot
     if details:
         kept.files[FAILURE_FILE] = failure_text(error).encode()
     reached = kept.summary["sim_time_s"]
