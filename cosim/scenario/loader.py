@@ -7,6 +7,7 @@ A file may extend a preset or another file (``extends = ...``): the chain is res
 from __future__ import annotations
 
 import copy
+import datetime
 import math
 import re
 import tomllib
@@ -33,6 +34,13 @@ from cosim.scenario.tomlfile import (
 
 PRESET_PACKAGE = "cosim.presets"
 _BARE_KEY = re.compile(r"[A-Za-z0-9_-]+")
+_TOML_ESCAPE = re.compile(r'["\\\x00-\x08\x0a-\x1f\x7f]')
+"""What a TOML basic string must escape: quote, backslash, control characters but tab."""
+
+
+def _escaped(match: re.Match[str]) -> str:
+    char = match.group()
+    return "\\" + char if char in '"\\' else f"\\u{ord(char):04x}"
 
 
 def preset_names() -> list[str]:
@@ -344,7 +352,7 @@ def toml_value(value: Any) -> str:
             raise ValueError(f"cannot write non-finite {value} to TOML")
         return repr(value)
     if isinstance(value, str):
-        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+        return '"' + _TOML_ESCAPE.sub(_escaped, value) + '"'
     if isinstance(value, list | tuple):
         return "[" + ", ".join(toml_value(v) for v in value) + "]"
     if is_dataclass(value) and not isinstance(value, type):
@@ -353,6 +361,21 @@ def toml_value(value: Any) -> str:
     if isinstance(value, Mapping):  # a carried section's inline table
         return "{" + ", ".join(f"{toml_key(k)} = {toml_value(v)}" for k, v in value.items()) + "}"
     raise TypeError(f"cannot write {type(value).__name__} to TOML")
+
+
+def _carried_value(value: Any) -> str:
+    """A carried section's value as TOML text, as the file gave it (``nan`` and ``inf`` too)."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return "nan" if value != value else ("inf" if value > 0 else "-inf")
+    if isinstance(value, datetime.date | datetime.time):  # a datetime is a date too
+        return value.isoformat()
+    if isinstance(value, list | tuple):
+        return "[" + ", ".join(_carried_value(v) for v in value) + "]"
+    if isinstance(value, Mapping):
+        return (
+            "{" + ", ".join(f"{toml_key(k)} = {_carried_value(v)}" for k, v in value.items()) + "}"
+        )
+    return toml_value(value)
 
 
 def toml_key(key: str) -> str:
@@ -380,7 +403,7 @@ def dump_scenario(scenario: Scenario, *, provenance: Mapping[str, str] | None = 
             lines.append(f"{f.name} = {toml_value(getattr(section, f.name))}")
     for name, table in scenario.carried.items():  # as given: no installed package reads them
         lines += ["", f"[{toml_key(name)}]"]
-        lines += [f"{toml_key(k)} = {toml_value(v)}" for k, v in table.items()]
+        lines += [f"{toml_key(k)} = {_carried_value(v)}" for k, v in table.items()]
     return "\n".join(lines) + "\n"
 
 

@@ -4,6 +4,8 @@ import json
 import shutil
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from cosim.core.errors import ExportError
 from cosim.recording.bag import BAG_DIR
@@ -107,3 +109,27 @@ def test_a_run_folder_names_its_bag_and_a_bag_names_itself(tmp_path):
     (newer / "summary.json").write_text(json.dumps({"format": RUN_FORMAT + 1}))
     with pytest.raises(ExportError, match="written by a newer cosim"):
         bag_of(newer)
+
+
+json_values = st.recursive(
+    st.one_of(st.none(), st.booleans(), st.integers(), st.floats(), st.text(max_size=5)),
+    lambda inner: st.one_of(
+        st.lists(inner, max_size=3), st.dictionaries(st.text(max_size=5), inner, max_size=3)
+    ),
+    max_leaves=6,
+)
+
+
+@settings(
+    max_examples=200, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(summary=st.one_of(json_values, st.dictionaries(st.just("format"), json_values)))
+def test_any_summary_gives_a_format_or_one_line_naming_the_file(summary, tmp_path):
+    (tmp_path / "summary.json").write_text(json.dumps(summary))
+    try:
+        found = folder_format(tmp_path)
+    except ExportError as error:
+        assert "\n" not in str(error) and str(error).startswith(str(tmp_path))
+    else:
+        assert 0 <= found <= RUN_FORMAT
+    assert isinstance(is_cosim_folder(tmp_path), bool)

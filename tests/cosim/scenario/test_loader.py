@@ -1,3 +1,4 @@
+import math
 from pathlib import Path
 
 import pytest
@@ -314,3 +315,21 @@ def test_an_unknown_section_without_provenance_still_gets_a_suggestion(tmp_path)
     path = _write(tmp_path, '[provenance]\ncosim = "0.1.0"\n\n[robot]\ncount = 2\n')
     with pytest.raises(ConfigError, match=r"unknown section \[robot\]; did you mean 'robots'"):
         cosim.load_scenario(path)
+
+
+def test_a_carried_section_keeps_what_toml_can_say_through_a_dump(tmp_path):
+    text = (
+        "[gone]\nx = nan\ny = [inf, -inf]\nwhen = 2026-11-28T10:00:00Z\nday = 2026-11-28\n"
+        'at = 07:32:00\n"odd key" = {a = 1, "b\\nc" = "d\\u0000"}\n'
+    )
+    scenario = cosim.load_scenario(_write(tmp_path, text), reading=True)
+    dumped = dump_scenario(scenario)
+    assert "\n[gone]\nx = nan\ny = [inf, -inf]\nwhen = 2026-11-28T10:00:00+00:00\n" in dumped
+    again = cosim.load_scenario(_write(tmp_path, dumped), reading=True).carried["gone"]
+    assert again["when"] == scenario.carried["gone"]["when"]
+    assert (
+        again["day"] == scenario.carried["gone"]["day"]
+        and again["at"] == scenario.carried["gone"]["at"]
+    )
+    assert again["odd key"] == {"a": 1, "b\nc": "d\x00"}
+    assert again["x"] != again["x"] and again["y"] == [math.inf, -math.inf]
