@@ -302,6 +302,9 @@ def _staged(result: RunResult, out: Path, *, tables: bool) -> tuple[Path | None,
     except OSError as error:
         discard(stage)  # a half-written copy helps nobody and takes the space
         return None, reason(error)
+    except BaseException:
+        discard(stage)
+        raise
     return stage, ""
 
 
@@ -311,9 +314,11 @@ def _spare_copy(result: RunResult, out: Path, *, tables: bool) -> Path | None:
     try:
         spare = spare_folder(out.name or "run")
         _write_files(result, spare, tables=tables)
-    except OSError:
+    except BaseException as error:
         discard(spare)
-        return None
+        if isinstance(error, OSError):
+            return None
+        raise
     return spare
 
 
