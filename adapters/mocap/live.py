@@ -27,6 +27,7 @@ from adapters.mocap.contract import SourceContext
 from cosim.core.adapter import RunContext
 from cosim.core.errors import BridgeError
 from cosim.core.kernel import Stage
+from cosim.core.summary import SummaryKey
 from cosim.core.timebase import NS_PER_S, period_ns, s_to_ns
 from cosim.scenario.sections import ScenarioSection
 from models.fleet.kinematics import FleetState
@@ -37,6 +38,14 @@ Sample = tuple[int, int, float, float, float]
 
 class LiveSourceError(BridgeError):
     """A live pose source failed, or sent no pose of a tracked robot in time."""
+
+
+LIVE_SUMMARY: Mapping[str, SummaryKey] = {
+    "mocap_connected": SummaryKey(
+        "true/false", "whether any pose of a tracked robot came from the live system"
+    ),
+}
+"""The summary key every live source writes (its subclasses' ``summary_keys`` hold it)."""
 
 
 class PolledSource:

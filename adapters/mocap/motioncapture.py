@@ -13,7 +13,7 @@ from typing import Any, ClassVar
 
 from adapters.mocap.contract import SourceContext, Tracked, bodies_or
 from adapters.mocap.feed import SYSTEMS, MotionCaptureFeed, mock_bodies
-from adapters.mocap.live import PolledSource, Sample
+from adapters.mocap.live import LIVE_SUMMARY, PolledSource, Sample
 from adapters.mocap.settings import MocapConfig
 from cosim.core.adapter import RunContext
 from cosim.core.summary import SummaryKey
@@ -26,6 +26,7 @@ class MotionCaptureSource(PolledSource):
 
     name: ClassVar[str] = "motioncapture"
     summary_keys: ClassVar[Mapping[str, SummaryKey]] = {
+        **LIVE_SUMMARY,
         "mocap_missing_bodies": SummaryKey("count", "tracked rigid bodies never seen in a frame"),
     }
     """The summary keys :meth:`summary` writes (documented in the summary reference)."""

@@ -13,7 +13,7 @@ from collections.abc import Iterator, Mapping
 from typing import Any, ClassVar
 
 from adapters.mocap.contract import SourceContext, Tracked, bodies_or
-from adapters.mocap.live import PolledSource, Sample
+from adapters.mocap.live import LIVE_SUMMARY, PolledSource, Sample
 from adapters.mocap.settings import MocapConfig, topic_problem
 from adapters.ros2dds.qos import QosKind
 from adapters.ros2dds.session import DdsSession, dds_session
@@ -44,6 +44,7 @@ class Ros2PoseSource(PolledSource):
 
     name: ClassVar[str] = "ros2"
     summary_keys: ClassVar[Mapping[str, SummaryKey]] = {
+        **LIVE_SUMMARY,
         "mocap_dds_invalid": SummaryKey(
             "count", "PoseStamped samples that hold no planar pose (refused before the intake)"
         ),

@@ -22,7 +22,7 @@ from collections.abc import Iterator, Mapping
 from typing import Any, ClassVar
 
 from adapters.mocap.contract import SourceContext, Tracked
-from adapters.mocap.live import LiveSourceError, PolledSource, Sample
+from adapters.mocap.live import LIVE_SUMMARY, LiveSourceError, PolledSource, Sample
 from adapters.mocap.ros2 import pattern_tracks, topic_bodies_problems
 from adapters.mocap.settings import MocapConfig
 from adapters.unity.server import UnitySink
@@ -40,6 +40,7 @@ class UnityPoseSource(PolledSource):
 
     name: ClassVar[str] = "unity"
     summary_keys: ClassVar[Mapping[str, SummaryKey]] = {
+        **LIVE_SUMMARY,
         "mocap_unity_poses": SummaryKey(
             "count", "poses received from Unity scenes (before the intake's checks)"
         ),

@@ -357,7 +357,8 @@ def build_parser() -> argparse.ArgumentParser:
     bag = commands.add_parser(
         "bag",
         help="look into ROS 2 bags (ours, or any rosbag2 recording)",
-        description="Commands on ROS 2 bags: a rosbag2 folder, or a bare .mcap or .db3 file.",
+        description="Commands on ROS 2 bags: a rosbag2 folder, a bare .mcap or .db3 file, or "
+        "a run folder (its bag/).",
     )
     bag_commands = bag.add_subparsers(dest="bag_command", metavar="COMMAND", parser_class=Parser)
     bag_commands.required = True
@@ -367,7 +368,9 @@ def build_parser() -> argparse.ArgumentParser:
         description="Print a bag's storage, size, message count, time span, and per topic its "
         "type and message count.",
     )
-    info.add_argument("bag", metavar="BAG", type=Path, help="a bag folder, or a .mcap/.db3 file")
+    info.add_argument(
+        "bag", metavar="BAG", type=Path, help="a bag folder, a .mcap/.db3 file, or a run folder"
+    )
 
     mapping = commands.add_parser(
         "map",
@@ -380,7 +383,9 @@ def build_parser() -> argparse.ArgumentParser:
             "estimate (RMS after rigid SE(2) alignment)."
         ),
     )
-    mapping.add_argument("bag", metavar="BAG", type=Path, help="a bag folder or .mcap/.db3 file")
+    mapping.add_argument(
+        "bag", metavar="BAG", type=Path, help="a bag folder, a .mcap/.db3 file, or a run folder"
+    )
     mapping.add_argument("--out", type=Path, required=True, help="output folder")
     mapping.add_argument("--scan", default="/scan", help="sensor_msgs/LaserScan topic (/scan)")
     mapping.add_argument("--odom", default="/odom", help="nav_msgs/Odometry topic (/odom)")
@@ -428,7 +433,9 @@ def build_parser() -> argparse.ArgumentParser:
         help="draw a run's figures from its folder",
         description=(
             "Draw figures of a run from its folder alone (scenario.toml and tables/), so any "
-            "earlier run can be plotted: the world with trajectories, snapshots with trails, "
+            "earlier run can be plotted (keys renamed since are read under their new names, "
+            "sections of plugins not installed are carried: a note on stderr says each): the "
+            "world with trajectories, snapshots with trails, "
             "a task timeline, the network over time, assignment convergence. PNGs go to "
             "RUN_DIR/figures/."
         ),

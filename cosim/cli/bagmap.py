@@ -4,6 +4,11 @@ Writes ``map.pgm`` + ``map.yaml`` (map_server), ``map.png`` (the map with the
 trajectories), ``trajectory.parquet`` and ``trajectory.csv`` (t_s, x_m, y_m, yaw_rad per
 scan, stamps from the bag) and ``summary.json``. The mapping itself is
 :func:`adapters.mapping.bagmap.map_recording`.
+
+The folder is marked as cosim's (``.cosim-run``, :mod:`cosim.runner.runfolder`); ``--force``
+replaces these files only in such a folder (or in one an earlier ``cosim map`` wrote before
+folders were marked), never another's. The results are written whole inside the folder
+first, then take their places (:mod:`cosim.runner.staging`).
 """
 
 from __future__ import annotations
@@ -15,10 +20,12 @@ from typing import Any
 
 import pandas as pd
 
-from adapters.mapping.bagmap import Progress, map_recording
+from adapters.mapping.bagmap import Progress, RecordingMap, map_recording
 from adapters.mapping.recording import check_topics
 from adapters.world.files import write_map
 from cosim.core.errors import ExportError
+from cosim.runner.runfolder import MARKER, is_cosim_folder, mark
+from cosim.runner.staging import discard, put_in_place, reason, stage_in
 from models.mapping.matcher import MatcherParams
 from models.mapping.slam import UpdateGate
 
@@ -86,44 +93,69 @@ def map_bag(
         clear_no_return_m=clear_no_return_m,
         progress=progress,
     )
-    _clear(out)
-    out.mkdir(parents=True, exist_ok=True)
     try:
-        files = write_map(mapped.grid.occupancy_grid(), out / "map.yaml")
-        mapped.trajectory.to_parquet(out / "trajectory.parquet", index=False)
-        mapped.trajectory.to_csv(out / "trajectory.csv", index=False)
-        from cosim.plotting.bagmap import bag_map_figure  # matplotlib only here
+        files = _write_outputs(out, mapped, bag.name)
+    except OSError as error:
+        raise ExportError(f"{out}: cannot write results ({reason(error)})") from None
+    return BagMapResult(out, mapped.summary, mapped.trajectory, files)
 
-        files += [out / "trajectory.parquet", out / "trajectory.csv"]
-        files.append(
-            bag_map_figure(
-                mapped.grid,
-                mapped.estimate_xy_m,
-                mapped.odometry_xy_m,
-                mapped.reference_xy_m,
-                out / "map.png",
-                bag.name,
-            )
+
+def _write_outputs(out: Path, mapped: RecordingMap, bag_name: str) -> list[Path]:
+    """Write the results whole into a staging folder in ``out``, then each in its place.
+
+    Raises:
+        OSError: the folder cannot take them (the staging folder is removed then).
+        ExportError: some are written but cannot take their places: where they are.
+    """
+    from cosim.plotting.bagmap import bag_map_figure  # matplotlib only here
+
+    out.mkdir(parents=True, exist_ok=True)
+    stage = stage_in(out)
+    try:
+        mark(stage, "map")
+        written = write_map(mapped.grid.occupancy_grid(), stage / "map.yaml")
+        mapped.trajectory.to_parquet(stage / "trajectory.parquet", index=False)
+        mapped.trajectory.to_csv(stage / "trajectory.csv", index=False)
+        bag_map_figure(
+            mapped.grid,
+            mapped.estimate_xy_m,
+            mapped.odometry_xy_m,
+            mapped.reference_xy_m,
+            stage / "map.png",
+            bag_name,
         )
-        (out / "summary.json").write_text(
+        (stage / "summary.json").write_text(
             json.dumps(mapped.summary, indent=2) + "\n", encoding="utf-8"
         )
-    except OSError as error:
-        raise ExportError(f"{out}: cannot write results ({error})") from None
-    files.append(out / "summary.json")
-    return BagMapResult(out, mapped.summary, mapped.trajectory, files)
+    except BaseException:
+        discard(stage)
+        raise
+    try:
+        put_in_place(stage, out)
+    except (OSError, ExportError) as error:
+        why = reason(error) if isinstance(error, OSError) else str(error)
+        raise ExportError(
+            f"{out}: cannot put the results in place ({why}); those not in place are in {stage}/"
+        ) from None
+    discard(stage)
+    names = [p.name for p in written] + [
+        "trajectory.parquet",
+        "trajectory.csv",
+        "map.png",
+        "summary.json",
+    ]
+    return [out / name for name in names]
 
 
 def _check_out(out: Path, force: bool) -> None:
     if out.exists() and not out.is_dir():
         raise ExportError(f"{out}: exists and is not a folder")
-    if out.is_dir() and any(out.iterdir()) and not force:
+    if not out.is_dir() or all(p.name == MARKER for p in out.iterdir()):
+        return
+    if not force:
         raise ExportError(f"{out}: folder is not empty; not overwriting (use --force)")
-
-
-def _clear(out: Path) -> None:
-    try:
-        for name in OUTPUTS:
-            (out / name).unlink(missing_ok=True)
-    except OSError as error:
-        raise ExportError(f"{out}: cannot replace earlier results ({error})") from None
+    if not is_cosim_folder(out, "map"):
+        raise ExportError(
+            f"{out}: not a folder of `cosim map` (no {MARKER}, nor its summary.json): --force "
+            "replaces only an earlier map's files; choose another --out"
+        )

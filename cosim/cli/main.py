@@ -7,6 +7,7 @@ Each command is a function of the parsed arguments returning the exit status;
 from __future__ import annotations
 
 import argparse
+import functools
 import os
 import sys
 import traceback
@@ -95,8 +96,8 @@ def _load(args: argparse.Namespace) -> Scenario:
         overrides[key] = value
     scenario = load_scenario(args.scenario, overrides)
     note = provenance_note(scenario.source, scenario.resolved_with)
-    if note is not None:
-        print(note, file=sys.stderr)
+    for line in (*scenario.notes, *([note] if note is not None else [])):
+        print(line, file=sys.stderr)
     return scenario
 
 
@@ -382,20 +383,22 @@ def _cmd_study(args: argparse.Namespace) -> int:
 
 def _cmd_bag(args: argparse.Namespace) -> int:
     from adapters.bags.reader import bag_info, format_info
+    from cosim.runner.runfolder import bag_of
 
-    print(format_info(bag_info(args.bag)))
+    print(format_info(bag_info(bag_of(args.bag))))
     return EXIT_OK
 
 
 def _cmd_map(args: argparse.Namespace) -> int:
     from cosim.cli.bagmap import map_bag
+    from cosim.runner.runfolder import bag_of
     from models.mapping.matcher import MatcherParams
     from models.mapping.slam import UpdateGate
 
     progress = None if args.quiet else ProgressLine(label=f"{args.bag.name}: ")
     try:
         result = map_bag(
-            args.bag,
+            bag_of(args.bag),
             args.out,
             scan_topic=args.scan,
             odom_topic=args.odom,
@@ -429,7 +432,8 @@ def _cmd_map(args: argparse.Namespace) -> int:
 def _cmd_plot(args: argparse.Namespace) -> int:
     from cosim.plotting.command import plot_run
 
-    for path in plot_run(args.run_dir, at=args.at, gif=args.gif, out=args.out):
+    say = functools.partial(print, file=sys.stderr)  # a line on how an old run was read
+    for path in plot_run(args.run_dir, at=args.at, gif=args.gif, out=args.out, note=say):
         print(f"wrote {path}")
     return EXIT_OK
 

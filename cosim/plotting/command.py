@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from cosim.core.errors import ExportError
@@ -32,6 +32,7 @@ def plot_run(
     at: Sequence[float] | None = None,
     gif: bool = False,
     out: Path | None = None,
+    note: Callable[[str], object] | None = None,
 ) -> list[Path]:
     """Draw the figures of a run from its folder alone; return the files written.
 
@@ -53,6 +54,8 @@ def plot_run(
         at: snapshot times (s from the start), within the run, at most 12.
         gif: also write the animation.
         out: folder for the files (created if needed).
+        note: called with each line on how an older folder was read (a key renamed since,
+            a section of a plugin not installed: :attr:`RunData.notes`).
 
     Returns:
         The files written, in the order above.
@@ -61,10 +64,14 @@ def plot_run(
         ExportError: ``run_dir`` is not a readable run folder (see
             :func:`~cosim.plotting.rundata.load_run`), a time of ``at`` is outside the run,
             or a file cannot be written; the message names the path or value.
-        ConfigError: the run's ``scenario.toml`` is invalid.
+        ConfigError: the run's ``scenario.toml`` is invalid (a folder of any earlier format
+            is read: :func:`cosim.runner.runfolder.read_run_scenario`).
         ScenarioError: the run's world cannot be rebuilt.
     """
     run = load_run(Path(run_dir))
+    if note is not None:
+        for line in run.notes:
+            note(line)
     times = snapshot_times(run, at)
     folder = Path(out) if out is not None else run.path / FIGURES_DIR
     written = [

@@ -5,6 +5,9 @@ Everything comes from the folder alone, so any old run can be drawn: ``scenario.
 seed, same random stream as the run) and ``tables/*.parquet``. Only the poses are
 required; tasks, messages and assignments are optional (older runs, other drivers or
 ``record.messages = false`` lack them) and only the columns drawn are required of them.
+A folder of any format is read (:func:`cosim.runner.runfolder.read_run_scenario`): keys
+renamed since are read under their new names, sections of plugins no longer installed are
+carried, each said in :attr:`RunData.notes`.
 """
 
 from __future__ import annotations
@@ -20,11 +23,11 @@ import pandas as pd
 from adapters.world.warehouse import scenario_warehouse
 from cosim.core.errors import ExportError
 from cosim.plotting.ownership import task_holds
-from cosim.scenario import Scenario, load_scenario
+from cosim.runner.runfolder import read_run_scenario
+from cosim.scenario import Scenario
 from models.arrays import FloatArray
 from models.world.warehouse import Warehouse
 
-SCENARIO_FILE = "scenario.toml"
 TABLES_DIR = "tables"
 POSE_COLUMNS = ("t_s", "robot", "x_m", "y_m", "yaw_rad")
 TASK_COLUMNS = (
@@ -117,6 +120,8 @@ class RunData:
             held at the end), ``end`` (``completed``, ``released`` or ``open``); None
             without tasks.
         navigation: ``tables/navigation`` (goals sent, arrivals), or None likewise.
+        notes: one line each on how the folder was read (a key renamed since, a section of
+            a plugin not installed), for the user.
     """
 
     path: Path
@@ -129,6 +134,7 @@ class RunData:
     humans: pd.DataFrame | None = None
     holds: pd.DataFrame | None = None
     navigation: pd.DataFrame | None = None
+    notes: tuple[str, ...] = ()
 
     @property
     def title(self) -> str:
@@ -141,18 +147,16 @@ def load_run(run_dir: Path) -> RunData:
 
     Raises:
         ExportError: ``run_dir`` is not a folder, has no ``scenario.toml`` or no
-            ``tables/poses.parquet``, a table cannot be read, lacks a column drawn, or
-            has no pose; the message names the path and what was expected.
+            ``tables/poses.parquet``, is of a newer format than this cosim reads, a table
+            cannot be read, lacks a column drawn, or has no pose; the message names the
+            path and what was expected.
         ConfigError: ``scenario.toml`` is invalid (naming the file and key).
         ScenarioError: the world of the scenario cannot be rebuilt.
     """
     run_dir = Path(run_dir)
     if not run_dir.is_dir():
         raise ExportError(f"{run_dir}: no such folder; expected a run folder (cosim run --out)")
-    source = run_dir / SCENARIO_FILE
-    if not source.is_file():
-        raise ExportError(f"{run_dir}: no {SCENARIO_FILE}; expected a run folder (cosim run --out)")
-    scenario = load_scenario(source)
+    scenario = read_run_scenario(run_dir)
     poses_path = run_dir / TABLES_DIR / "poses.parquet"
     poses = _read(poses_path, "poses", POSE_COLUMNS)
     if poses.empty:
@@ -172,6 +176,7 @@ def load_run(run_dir: Path) -> RunData:
         humans=_optional(run_dir, "humans", HUMAN_COLUMNS),
         holds=holds,
         navigation=navigation,
+        notes=scenario.notes,
     )
 
 

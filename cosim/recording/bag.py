@@ -12,6 +12,7 @@ commits every :data:`COMMIT_EVERY` messages for the same reason.
 from __future__ import annotations
 
 import contextlib
+import sqlite3
 import struct
 import sys
 from collections.abc import Mapping, Sequence
@@ -173,7 +174,10 @@ class BagSink:
         """
         if self._compress:
             data = zstd.compress(data, level=ZSTD_LEVEL)
-        self._store(self._connections[channel], t_ns, data)
+        try:
+            self._store(self._connections[channel], t_ns, data)
+        except (OSError, sqlite3.Error) as error:  # a full disk: the run ends, keeping what ran
+            raise ExportError(f"{self.path}: cannot write the bag ({error})") from error
         self._counts[channel] += 1
         if self._first_ns is None:
             self._first_ns = t_ns
@@ -188,7 +192,10 @@ class BagSink:
         storage = self._writer.storage if self._writer is not None else None
         conn = getattr(storage, "conn", None)
         if conn is not None:
-            conn.commit()
+            try:
+                conn.commit()
+            except sqlite3.Error as error:
+                raise ExportError(f"{self.path}: cannot write the bag ({error})") from error
         self._since_commit = 0
 
     def close(self) -> None:
@@ -201,7 +208,7 @@ class BagSink:
                 writer.min_timestamp, writer.max_timestamp = self._first_ns, self._last_ns
             try:
                 writer.close()
-            except (WriterError, OSError) as error:
+            except (WriterError, OSError, sqlite3.Error) as error:
                 _release(writer.storage)  # a full disk: do not hold its file open too
                 raise ExportError(f"{self.path}: cannot finish the bag ({error})") from None
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from adapters.unity.server import UnityOptions
 from cosim.core.adapter import AdapterType
-from cosim.core.errors import BridgeError, CosimError, RegistryError
+from cosim.core.errors import BridgeError, CosimError, ExportError, RegistryError
 from cosim.core.kernel import Lateness
 from cosim.core.plugins import PluginError, refuse
 from cosim.core.recorder import Recorder, merge_counts
@@ -32,13 +32,13 @@ from cosim.runner.faults import (
     InternalError,
     fault_of,
     plugin_faults_named,
-    write_failure,
 )
-from cosim.runner.outfolder import prepare_out, write_run
+from cosim.runner.outfolder import prepare_out, write_kept, write_run
 from cosim.runner.provenance import run_plugins
 from cosim.runner.result import RunResult
 from cosim.runner.stopping import CHECK_EVERY_S, RunStopped, StopRequest, signal_name
 from cosim.runner.watchdog import Watchdog
+from cosim.scenario.loader import check_runnable
 from cosim.scenario.model import Scenario
 
 ProgressFn = Callable[[float, float, float], None]
@@ -106,6 +106,7 @@ def execute(
         InternalError: cosim's own code failed once the run had started (a bug); ``kept``
             and ``details`` likewise.
     """
+    check_runnable(scenario)
     with CompileClock() as clock:  # numba's compile time, said apart from the speed
         with _immediate(stop):
             plan = RecordingPlan.for_run(scenario, out, live, unity)
@@ -132,6 +133,7 @@ def execute(
             if folder is None
             else lambda: prepare_out(folder, force=force, bag=bag, figures=figures)
         )
+        unfinished: ExportError | None = None
         try:
             with _immediate(stop):
                 if plan.active:
@@ -146,15 +148,29 @@ def execute(
                 result = _run_assembled(scenario, assembly, progress, stop, clock)
         finally:
             with _deferred(stop):  # the bag is finished (metadata.yaml) whatever stopped the run
-                session.close()
+                unfinished = _close(session)
     result.compile_time_s = round(clock.seconds, 3)
     result.bag = plan.bag
     result.recorded = session.counts()
     result.summary.update(session.summary())
     if result.failure is not None:
+        if unfinished is not None and not isinstance(result.failure, ExportError):
+            result.failure.say_kept(str(unfinished))
         result.failure.kept = result
         raise result.failure
+    if unfinished is not None:  # the bag could not be finished: the rest of the run is kept
+        unfinished.kept = result
+        raise unfinished
     return result
+
+
+def _close(session: RecordingSession) -> ExportError | None:
+    """Finish the bag and the live servers; the error when the bag cannot be finished."""
+    try:
+        session.close()
+    except ExportError as error:
+        return error
+    return None
 
 
 def with_adapters(
@@ -241,7 +257,7 @@ def _run_assembled(
                 )
     except _HaltError:
         halted, events = True, run.kernel.events_processed - counted
-    except BridgeError as error:  # the real world failed (a silent robot, a mocap server)
+    except (BridgeError, ExportError) as error:  # the world failed: a silent robot, a full disk
         halted, events, failure = True, run.kernel.events_processed - counted, error
     except (Exception, Hung) as error:  # user code, or cosim's: named, and what ran kept
         halted, events = True, run.kernel.events_processed - counted
@@ -332,7 +348,7 @@ def failure_summary(failure: CosimError, planned_s: float, unfinished: list[str]
         kind = "plugin"
     elif isinstance(failure, InternalError):
         kind = "cosim"
-    elif isinstance(failure, BridgeError):
+    elif isinstance(failure, BridgeError | ExportError):
         kind = "external"
     else:
         kind = "input"
@@ -479,15 +495,7 @@ def run(
         except CosimError as error:
             if error.kept is None or folder is None:
                 raise
-            write_run(error.kept, folder, tables=scenario.record.tables)
-            reached = error.kept.summary["sim_time_s"]
-            if getattr(error, "details", ""):
-                trace = write_failure(folder, error)
-                error.say_kept(f"the traceback is in {trace}")
-            error.say_kept(
-                f"the results of the {reached:g} s simulated are in {folder}/ "
-                '(summary.json says "failed")'
-            )
+            write_kept(error, folder, tables=scenario.record.tables)
             raise
         if folder is not None:
             write_run(result, folder, tables=scenario.record.tables)

@@ -173,12 +173,10 @@ def blame(trace: TracebackType | None) -> tuple[PluginInfo | None, str]:
     return None, ours
 
 
-def write_failure(folder: Path, error: CosimError) -> Path:
-    """Write the one-line error and its traceback into ``folder``; return the file."""
-    path = folder / FAILURE_FILE
+def failure_text(error: CosimError) -> str:
+    """What a run folder's :data:`FAILURE_FILE` holds: the one-line error, its traceback."""
     details = getattr(error, "details", "") or ""
-    path.write_text(f"{error}\n\n{details}")
-    return path
+    return f"{error}\n\n{details}"
 
 
 def _where(frame: FrameType, line: int | None) -> str:

@@ -345,6 +345,7 @@ def build(
     section: str,
     origins: Mapping[str, str],
     default_origin: str,
+    unregistered: list[tuple[str, Any]] | None = None,
 ) -> T:
     """Validate a TOML table and build the section dataclass ``cls`` from it.
 
@@ -354,6 +355,9 @@ def build(
         section: the section's name, for messages.
         origins: where each key came from (a file, or ``--set``), for messages.
         default_origin: the origin reported for cross-field problems of defaults.
+        unregistered: when given, a key naming what no installed package registers is
+            taken as it is and listed here as (key, value), not refused (a finished run's
+            scenario read for its results, a plugin it used uninstalled since).
 
     Raises:
         ConfigError: naming the origin, the section, the key, the value and what was
@@ -388,7 +392,12 @@ def build(
                 raise ConfigError(format_problem(origin, section, key, raw, expected))
         group = fields[key].metadata.get("registry")
         if group is not None and value != fields[key].metadata.get("off"):
-            _check_registered(group, value, origin, section, key, raw)
+            try:
+                _check_registered(group, value, origin, section, key, raw)
+            except ConfigError:
+                if unregistered is None:
+                    raise
+                unregistered.append((key, value))
         values[key] = value
     instance = cls(**values)
     problems = getattr(instance, "problems", None)

@@ -7,7 +7,9 @@ A file may extend a preset or another file (``extends = ...``): the chain is res
 from __future__ import annotations
 
 import copy
+import datetime
 import math
+import re
 import tomllib
 from collections.abc import Mapping
 from dataclasses import fields, is_dataclass, replace
@@ -24,8 +26,9 @@ from cosim.scenario.arguments import (
 )
 from cosim.scenario.extends import resolve as resolve_extends
 from cosim.scenario.fields import build, show_name, show_value, suggest
+from cosim.scenario.migrations import leftover, migrate, renamed_hint
 from cosim.scenario.model import Scenario, section_classes, section_registry
-from cosim.scenario.provenance import provenance_lines, split_provenance
+from cosim.scenario.provenance import missing_packages, provenance_lines, split_provenance
 from cosim.scenario.tomlfile import (
     MAX_DEPTH,
     deeper_than,
@@ -36,6 +39,14 @@ from cosim.scenario.tomlfile import (
 )
 
 PRESET_PACKAGE = "cosim.presets"
+_BARE_KEY = re.compile(r"[A-Za-z0-9_-]+")
+_TOML_ESCAPE = re.compile(r'["\\\x00-\x08\x0a-\x1f\x7f]')
+"""What a TOML basic string must escape: quote, backslash, control characters but tab."""
+
+
+def _escaped(match: re.Match[str]) -> str:
+    char = match.group()
+    return "\\" + char if char in '"\\' else f"\\u{ord(char):04x}"
 
 
 def preset_names() -> list[str]:
@@ -114,8 +125,13 @@ def load_scenario(
     *,
     override_origin: str = "--set",
     override_origins: Mapping[str, str] | None = None,
+    reading: bool = False,
 ) -> Scenario:
     """Load and validate a scenario from a TOML file or a preset name.
+
+    A key renamed since the file was written (:data:`~cosim.scenario.migrations.RENAMES`)
+    is read under its new name when the rename kept its meaning, with a note
+    (:attr:`Scenario.notes`); one whose model changed too is refused, naming the key to set.
 
     Args:
         spec: a path to a TOML file (which may extend a preset or another file), or the
@@ -124,6 +140,11 @@ def load_scenario(
         override_origin: how messages name the origin of overrides.
         override_origins: how messages name the origin of some overrides, by key (a
             study's ``--set`` among its grid's keys); the others: ``override_origin``.
+        reading: the scenario of a finished run, loaded to read its results (figures,
+            reports): every renamed key is read under its new name, and sections and
+            registered names that no installed package provides any more are carried
+            (:attr:`Scenario.carried`), not refused; each said in :attr:`Scenario.notes`.
+            Such a scenario cannot be run.
 
     Raises:
         ConfigError: for a missing file, malformed TOML, an unknown section or key, or a
@@ -151,7 +172,7 @@ def load_scenario(
         table[key] = value
         named = (override_origins or {}).get(dotted, override_origin)
         origins[(section, key)] = f"{named} {dotted}"
-    return _build(raw, origin, origins, layers.sections)
+    return _build(raw, origin, origins, layers.sections, reading=reading)
 
 
 def section_types() -> dict[str, type[Any]]:
@@ -164,31 +185,50 @@ def _build(
     origin: str,
     origins: dict[tuple[str, str], str],
     sections: Mapping[str, str] | None = None,
+    *,
+    reading: bool = False,
 ) -> Scenario:
     """Validate raw sections into a scenario.
 
     ``origins`` names where each (section, key) came from and ``sections`` where each
     section did (a file of an ``extends`` chain, ``--set``); ``origin`` where neither says.
     A ``[provenance]`` table is taken apart (:attr:`Scenario.resolved_with`), not a section.
+    ``reading``: as :func:`load_scenario`'s.
     """
     raw, resolved_with = split_provenance(raw, origin, origins)
-    registry = section_registry()
+    migrated = migrate(raw, origin, meaning_changes=reading)
+    raw, notes = migrated.tables, list(migrated.notes)
+    for rename in migrated.applied:  # a key read under its new name came from the old's file
+        old, new = rename.old.partition("."), rename.new.partition(".")
+        if (old[0], old[2]) in origins:
+            origins[(new[0], new[2])] = origins[(old[0], old[2])]
     sections = sections or {}
-    for section in raw:
-        if section not in registry:
-            where = sections.get(section) or next(
-                (o for (s, _), o in origins.items() if s == section), origin
-            )
-            raise ConfigError(
-                f"{where}: unknown section [{show_name(section)}]"
-                + suggest(section, registry.names())
-                + " (sections come from installed packages: `cosim plugins` lists them)"
-            )
+    _refuse_renamed(raw, origin, origins)
+    registry = section_registry()
+    carried: dict[str, Any] = {}
+    for section in list(raw):
+        if section in registry:
+            continue
+        if reading and isinstance(raw[section], dict):
+            carried[section] = raw.pop(section)
+            continue
+        where = sections.get(section) or next(
+            (o for (s, _), o in origins.items() if s == section), origin
+        )
+        raise ConfigError(
+            f"{where}: unknown section [{show_name(section)}]"
+            + _unknown_section_hint(section, registry.names(), resolved_with)
+        )
     try:
         classes = section_classes(needed=raw.keys())
     except RegistryError as error:  # the file uses a plugin that cannot load: say which
-        raise ConfigError(f"{origin}: {error}") from None
+        if not reading:
+            raise ConfigError(f"{origin}: {error}") from None
+        classes = section_classes()
+        for section in [s for s in raw if s not in classes]:
+            carried[section] = raw.pop(section)
     built: dict[str, Any] = {}
+    unregistered: list[tuple[str, Any]] = []
     for section, cls in classes.items():
         table = raw.get(section, {})
         where = sections.get(section, origin)
@@ -198,11 +238,84 @@ def _build(
             )
         key_origins = {key: origins.get((section, key), where) for key in table}
         table, key_origins = _apply_profile(cls, table, key_origins, section, where)
+        found: list[tuple[str, Any]] = []
         built[section] = _resolve_paths(
-            build(cls, table, section=section, origins=key_origins, default_origin=where),
+            build(
+                cls,
+                table,
+                section=section,
+                origins=key_origins,
+                default_origin=where,
+                unregistered=found if reading else None,
+            ),
             key_origins,
         )
-    return Scenario(built, source=origin, resolved_with=resolved_with)
+        unregistered += [(f"{section}.{key}", value) for key, value in found]
+    if carried or unregistered:
+        notes.append(_carried_note(origin, carried, unregistered, resolved_with))
+    return Scenario(
+        built, source=origin, resolved_with=resolved_with, carried=carried, notes=tuple(notes)
+    )
+
+
+def check_runnable(scenario: Scenario) -> None:
+    """Refuse to run a scenario read with sections no installed package registers.
+
+    Raises:
+        ConfigError: naming the sections and the packages to install.
+    """
+    if not scenario.carried:
+        return
+    missing = missing_packages(scenario.resolved_with)
+    install = f"install {', '.join(missing)}" if missing else "install the plugin that registers it"
+    names = ", ".join(f"[{show_name(name)}]" for name in scenario.carried)
+    raise ConfigError(
+        f"{scenario.source}: unknown section {names}: no installed package registers it; it "
+        f"was read to draw a run, not to run one ({install} to run it)"
+    )
+
+
+def _refuse_renamed(
+    raw: Mapping[str, Any], origin: str, origins: Mapping[tuple[str, str], str]
+) -> None:
+    """Refuse a key renamed with a change of model (left by the migration), naming the new."""
+    rename = leftover(raw)
+    if rename is not None:
+        section, _, key = rename.old.partition(".")
+        where = origins.get((section, key), origin)
+        raise ConfigError(f"{where}: [{section}] unknown key {key!r}" + renamed_hint(rename))
+
+
+def _unknown_section_hint(section: str, names: list[str], resolved_with: Mapping[str, str]) -> str:
+    """What to do about a section no installed package registers."""
+    missing = missing_packages(resolved_with)
+    if missing:
+        return (
+            f": no installed package registers it; the file was resolved with "
+            f"{', '.join(missing)}, not installed here: install it to run this scenario "
+            "(`cosim plot` and studies' reports read a run's tables without it)"
+        )
+    return (
+        suggest(section, names)
+        + " (sections come from installed packages: `cosim plugins` lists them)"
+    )
+
+
+def _carried_note(
+    origin: str,
+    carried: Mapping[str, Any],
+    unregistered: list[tuple[str, Any]],
+    resolved_with: Mapping[str, str],
+) -> str:
+    """The one line saying what of a run's scenario no installed package reads."""
+    parts = [f"[{show_name(name)}]" for name in carried]
+    parts += [f"{key} = {show_value(value)}" for key, value in unregistered]
+    missing = missing_packages(resolved_with)
+    used = f" (the run used {', '.join(missing)})" if missing else ""
+    return (
+        f"note: {origin}: {', '.join(parts)} carried unread: no installed package provides "
+        f"{'it' if len(parts) == 1 else 'them'}{used}; the run's tables are read without it"
+    )
 
 
 def _resolve_paths(section: Any, origins: Mapping[str, str]) -> Any:
@@ -253,13 +366,35 @@ def toml_value(value: Any) -> str:
             raise ValueError(f"cannot write non-finite {value} to TOML")
         return repr(value)
     if isinstance(value, str):
-        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+        return '"' + _TOML_ESCAPE.sub(_escaped, value) + '"'
     if isinstance(value, list | tuple):
         return "[" + ", ".join(toml_value(v) for v in value) + "]"
     if is_dataclass(value) and not isinstance(value, type):
         inner = ", ".join(f"{f.name} = {toml_value(getattr(value, f.name))}" for f in fields(value))
         return "{" + inner + "}"
+    if isinstance(value, Mapping):  # a carried section's inline table
+        return "{" + ", ".join(f"{toml_key(k)} = {toml_value(v)}" for k, v in value.items()) + "}"
     raise TypeError(f"cannot write {type(value).__name__} to TOML")
+
+
+def _carried_value(value: Any) -> str:
+    """A carried section's value as TOML text, as the file gave it (``nan`` and ``inf`` too)."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return "nan" if value != value else ("inf" if value > 0 else "-inf")
+    if isinstance(value, datetime.date | datetime.time):  # a datetime is a date too
+        return value.isoformat()
+    if isinstance(value, list | tuple):
+        return "[" + ", ".join(_carried_value(v) for v in value) + "]"
+    if isinstance(value, Mapping):
+        return (
+            "{" + ", ".join(f"{toml_key(k)} = {_carried_value(v)}" for k, v in value.items()) + "}"
+        )
+    return toml_value(value)
+
+
+def toml_key(key: str) -> str:
+    """A key as TOML text: bare when it can be, else quoted."""
+    return key if key and _BARE_KEY.fullmatch(key) else toml_value(key)
 
 
 def dump_scenario(scenario: Scenario, *, provenance: Mapping[str, str] | None = None) -> str:
@@ -280,6 +415,9 @@ def dump_scenario(scenario: Scenario, *, provenance: Mapping[str, str] | None = 
         lines.append(f"[{name}]")
         for f in fields(section):
             lines.append(f"{f.name} = {toml_value(getattr(section, f.name))}")
+    for name, table in scenario.carried.items():  # as given: no installed package reads them
+        lines += ["", f"[{toml_key(name)}]"]
+        lines += [f"{toml_key(k)} = {_carried_value(v)}" for k, v in table.items()]
     return "\n".join(lines) + "\n"
 
 

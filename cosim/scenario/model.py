@@ -81,11 +81,18 @@ class Scenario:
         source: the file or preset it was loaded from (for messages and provenance).
         resolved_with: the file's ``[provenance]``: package -> the version a run used (not
             a setting: see :mod:`cosim.scenario.provenance`).
+        carried: sections no installed package registers, as the file gave them (section
+            -> its TOML table): only a finished run's scenario read for its results has any
+            (``load_scenario(..., reading=True)``); such a scenario cannot be run.
+        notes: one line each for the user, said when the file was loaded: keys read under
+            their new names (:mod:`cosim.scenario.migrations`), sections carried.
     """
 
     sections: Mapping[str, Any] = field(default_factory=dict)
     source: str = field(default="<defaults>", compare=False)
     resolved_with: Mapping[str, str] = field(default_factory=dict, compare=False)
+    carried: Mapping[str, Any] = field(default_factory=dict)
+    notes: tuple[str, ...] = field(default=(), compare=False)
     _by_type: Mapping[type[Any], Any] = field(
         default_factory=dict, init=False, repr=False, compare=False
     )
@@ -99,11 +106,21 @@ class Scenario:
         ):
             sections.setdefault(name, kind())
         object.__setattr__(self, "sections", MappingProxyType(sections))
+        object.__setattr__(self, "carried", MappingProxyType(dict(self.carried)))
         object.__setattr__(self, "_by_type", {type(s): s for s in sections.values()})
 
     def __reduce__(self) -> tuple[Any, ...]:
         # the mapping proxy does not pickle: studies send scenarios to worker processes
-        return (Scenario, (dict(self.sections), self.source, dict(self.resolved_with)))
+        return (
+            Scenario,
+            (
+                dict(self.sections),
+                self.source,
+                dict(self.resolved_with),
+                dict(self.carried),
+                self.notes,
+            ),
+        )
 
     def section(self, kind: type[S]) -> S:
         """The section of type ``kind``.
@@ -212,7 +229,13 @@ class Scenario:
             raise wrong_type(
                 "Scenario.with_section", "section", section, "a settings instance (a dataclass)"
             )
-        return Scenario({**self.sections, name: section}, self.source, self.resolved_with)
+        return Scenario(
+            {**self.sections, name: section},
+            self.source,
+            self.resolved_with,
+            self.carried,
+            self.notes,
+        )
 
     def with_seed(self, seed: int) -> Scenario:
         """Return a copy with another seed.

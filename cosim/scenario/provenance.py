@@ -106,6 +106,11 @@ def provenance_note(source: str, resolved_with: Mapping[str, str]) -> str | None
     )
 
 
+def missing_packages(resolved_with: Mapping[str, str]) -> list[str]:
+    """``package version`` of each package ``resolved_with`` names that is not installed."""
+    return [f"{p} {said}" for p, said in resolved_with.items() if not _installed_version(p)]
+
+
 def _installed_version(package: str) -> str:
     try:
         return version(package)

@@ -6,20 +6,25 @@ replayed bag), and the sections of the resolved scenario with the package that r
 each. Resuming over a folder whose fingerprint differs is refused in one line saying what
 changed (a file, the first line of a finished run's ``scenario.toml`` that differs), unless
 the only change is a section a newly installed package added that changes no run
-(:mod:`cosim.studies.gained`): then the study resumes, and says so.
+(:mod:`cosim.studies.gained`), or keys renamed since with their meaning kept
+(:data:`cosim.scenario.migrations.RENAMES`): then the study resumes, and says so.
 """
 
 from __future__ import annotations
 
 import hashlib
+import tomllib
 from collections.abc import Collection, Iterator
-from dataclasses import fields
+from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any
 
-from cosim.core.errors import ConfigError
+from cosim.core.errors import ConfigError, ExportError
+from cosim.runner.runfolder import read_run_scenario
 from cosim.scenario import Scenario, load_scenario
+from cosim.scenario.fields import show_value
 from cosim.scenario.loader import dump_scenario
+from cosim.scenario.migrations import migrate
 from cosim.studies.gained import (
     dump_of,
     gained,
@@ -32,9 +37,24 @@ from cosim.studies.gained import (
 from cosim.studies.spec import RunSpec, StudySpec
 from cosim.studies.worker import Job, job_scenario, run_overrides
 
+PLAN_FILE = "plan.json"
 RUNS_DIR = "runs"
 SCENARIO_FILE = "scenario.toml"
 CHUNK = 1 << 20
+
+
+@dataclass(frozen=True)
+class Compared:
+    """A finished run's ``scenario.toml`` against what the study would run now.
+
+    Attributes:
+        change: ``""`` the same (its keys read under today's names), the first difference,
+            or None when the file cannot be read.
+        notes: one line per key of the file read under its new name.
+    """
+
+    change: str | None
+    notes: tuple[str, ...] = ()
 
 
 def job_of(spec: StudySpec, run: RunSpec) -> Job:
@@ -116,12 +136,14 @@ def check_fingerprint(
     old: dict[str, Any],
     new: dict[str, Any],
     finished: dict[str, Any],
-) -> str | None:
-    """Refuse a folder whose runs depended on other files or another scenario.
+) -> list[str]:
+    """Refuse a folder whose runs depended on other files or another scenario; notes.
 
     Returns:
-        A note when the scenario differs only by sections a newly installed package added
-        that change no run (the study resumes), else None.
+        Notes when the scenario differs only by sections a newly installed package added
+        that change no run, or only by keys renamed since with their meaning kept (every
+        finished run's ``scenario.toml`` is today's once its keys are read under their new
+        names): the study resumes. Empty when nothing differs.
 
     Raises:
         ConfigError: naming the file, the first line of the scenario that changed, or the
@@ -133,11 +155,20 @@ def check_fingerprint(
             what = f"{name} (a file the scenario reads) changed"
             raise ConfigError(changed(spec, out, what, finished))
     if old.get("scenario") == new["scenario"]:
-        return None
+        return []
     note = _sections_only(spec, out, old, new, finished)
     if note is not None:
-        return note
-    where = _first_scenario_change(spec, out, finished)
+        return [note]
+    planned = {r.run_id: r for r in spec.runs()}
+    compared = {r: scenario_change(spec, out, planned[r]) for r in finished if r in planned}
+    renamed = [note for c in compared.values() for note in c.notes]
+    if compared and renamed and all(c.change == "" for c in compared.values()):
+        return [
+            f"{out / PLAN_FILE}: the scenario differs from the plan's only by keys renamed "
+            "since; resuming",
+            *dict.fromkeys(renamed),
+        ]
+    where = next((f" (run {run_id}: {c.change})" for run_id, c in compared.items() if c.change), "")
     raise ConfigError(changed(spec, out, f"the scenario {spec.scenario} changed{where}", finished))
 
 
@@ -184,38 +215,48 @@ def _sections_only(
     return gained_line(found, str(out), len(finished))
 
 
-def _first_scenario_change(spec: StudySpec, out: Path, finished: dict[str, Any]) -> str:
-    """`` (run R: `line` then, `line` now)`` from the first finished run, or ""."""
-    planned = {r.run_id: r for r in spec.runs()}
-    for run_id in finished:
-        if run_id in planned:
-            change = scenario_change(spec, out, planned[run_id])
-            if change:
-                return f" (run {run_id}: {change})"
-    return ""
-
-
-def scenario_change(spec: StudySpec, out: Path, run: RunSpec) -> str | None:
+def scenario_change(spec: StudySpec, out: Path, run: RunSpec) -> Compared:
     """How a finished run's ``scenario.toml`` differs from what the study runs now.
 
     Sections the run's file does not have (a package installed since) are left out of the
-    comparison: :func:`check_fingerprint` and :func:`gained_since` judge them.
-
-    Returns:
-        "" when they are the same, the first differing line when not, None when the run
-        has no readable ``scenario.toml``.
+    comparison: :func:`check_fingerprint` and :func:`gained_since` judge them. Keys renamed
+    since are read under their new names first: a rename that kept the meaning is no
+    difference (it is noted), one whose model changed is the difference.
     """
+    folder = out / RUNS_DIR / run.run_id
     try:
-        then = (out / RUNS_DIR / run.run_id / SCENARIO_FILE).read_text(encoding="utf-8")
+        then = (folder / SCENARIO_FILE).read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError):
-        return None
+        return Compared(None)
     scenario = job_scenario(job_of(spec, run))
     sections = toml_sections(then)
     now = dump_scenario(scenario) if sections is None else dump_of(scenario, sections)
     if then == now:
-        return ""
+        return Compared("")
+    try:
+        raw = tomllib.loads(then)
+        applied = migrate(raw, str(folder / SCENARIO_FILE)).applied
+        old = read_run_scenario(folder)
+    except (tomllib.TOMLDecodeError, ConfigError, ExportError):
+        return Compared(_first_difference(then, now))
+    for rename in applied:
+        if not rename.same_meaning:
+            section, _, key = rename.old.partition(".")
+            value = show_value(raw[section][key])
+            return Compared(
+                f"{rename.old} = {value} then, renamed {rename.new} in {rename.commit}: "
+                f"{rename.change}"
+            )
+    migrated = dump_scenario(old) if sections is None else dump_of(old, sections)
+    if migrated.split("\n", 1)[1:] == now.split("\n", 1)[1:]:  # but the source line
+        return Compared("", old.notes)
+    return Compared(_first_difference(migrated, now))
+
+
+def _first_difference(then: str, now: str) -> str:
+    """```line` then, `line` now`` for the first line that differs, or the line counts."""
     old_lines, new_lines = then.splitlines(), now.splitlines()
-    for a, b in zip(old_lines, new_lines, strict=False):
+    for a, b in zip(old_lines[1:], new_lines[1:], strict=False):
         if a != b:
             return f"`{a}` then, `{b}` now"
     return f"{len(old_lines)} lines then, {len(new_lines)} now"
@@ -242,8 +283,10 @@ def gained_since(spec: StudySpec, out: Path, run: RunSpec, finished: dict[str, A
 
 
 __all__ = [
+    "PLAN_FILE",
     "RUNS_DIR",
     "SCENARIO_FILE",
+    "Compared",
     "changed",
     "check_fingerprint",
     "combinations",

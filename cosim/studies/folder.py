@@ -6,7 +6,7 @@ The folder::
     runs/<run_id>/      row.json, summary.json, scenario.toml[, tables/*.parquet]
     results.parquet     one row per run
 
-A run's folder appears at once, complete (written beside it, then renamed). ``--resume``
+A run's folder appears at once, complete (:mod:`cosim.studies.writing`). ``--resume``
 continues only the study that started the folder: the same runs (seeds, overrides,
 duration, tables) of the same resolved scenario and the same files it reads
 (:mod:`cosim.studies.fingerprint`; a section that a package installed since added, and
@@ -15,22 +15,27 @@ lost or garbled, the finished runs are the evidence: each one's row and ``scenar
 must be what this study would run, and then the plan is written again. A run whose
 ``row.json`` cannot be read, or is not the planned run's (its seed or an override
 differs), is run again.
+
+Run folders of every earlier format are read (:mod:`cosim.runner.runfolder`): a key
+renamed since with its meaning kept (:data:`cosim.scenario.migrations.RENAMES`) is the
+same setting, so a finished run whose ``scenario.toml`` differs from today's only by such
+names is resumed, with a note; a rename whose model changed too is a changed scenario,
+named as such.
 """
 
 from __future__ import annotations
 
 import json
 import os
-import shutil
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import pandas as pd
-
 from cosim.core.errors import ConfigError, ExportError
-from cosim.runner.faults import FAILURE_FILE
+from cosim.runner.runfolder import folder_format
+from cosim.scenario.migrations import migrate_dotted
 from cosim.studies.fingerprint import (
+    PLAN_FILE,
     RUNS_DIR,
     SCENARIO_FILE,
     changed,
@@ -41,12 +46,12 @@ from cosim.studies.fingerprint import (
     scenario_change,
 )
 from cosim.studies.spec import StudySpec
-from cosim.studies.worker import Outcome, row_cells
+from cosim.studies.worker import row_cells
 
-PLAN_FILE = "plan.json"
 ROW_FILE = "row.json"
 RESULTS_FILE = "results.parquet"
 PARTIAL = ".partial"
+"""What the folders of runs on their way ended with before format 1 (never read)."""
 
 
 @dataclass(frozen=True)
@@ -144,9 +149,15 @@ def _run_folders(out: Path) -> dict[str, _Found]:
     if not runs.is_dir():
         return {}
     try:
-        folders = [p for p in runs.iterdir() if p.is_dir() and not p.name.endswith(PARTIAL)]
+        folders = [
+            p
+            for p in runs.iterdir()
+            if p.is_dir() and not p.name.startswith(".") and not p.name.endswith(PARTIAL)
+        ]
     except OSError as error:
         raise ExportError(f"{runs}: cannot read the study's runs ({_reason(error)})") from None
+    for folder in folders:  # a run of a newer format than this cosim reads stops the resume
+        folder_format(folder)
     return {p.name: read_row(p / ROW_FILE) for p in sorted(folders)}
 
 
@@ -196,8 +207,7 @@ def inspect(spec: StudySpec, out: Path, *, resume: bool) -> FolderState:
         what = f"the study's runs changed ({difference})"
         raise ConfigError(changed(spec, out, what, finished))
     if old is not None and isinstance(old.get("fingerprint"), dict):
-        note = check_fingerprint(spec, out, old["fingerprint"], plan["fingerprint"], finished)
-        notes += [note] if note else []
+        notes += check_fingerprint(spec, out, old["fingerprint"], plan["fingerprint"], finished)
         done = set()
         for run_id in (r for r in finished if r in planned):
             if bad := _unlike(finished[run_id], row_cells(job_of(spec, planned[run_id]))):
@@ -223,7 +233,7 @@ def _plan_difference(old: dict[str, Any], new: dict[str, Any]) -> str:
     for key in ("scenario", "duration_s", "tables"):
         if key in old and _canonical(old[key]) != _canonical(new[key]):
             return f"{key} {_canonical(old[key])} then, {_canonical(new[key])} now"
-    then = {str(r.get("run_id")): r for r in old["runs"] if isinstance(r, dict)}
+    then = {str(r.get("run_id")): _renamed_run(r) for r in old["runs"] if isinstance(r, dict)}
     now = {r["run_id"]: r for r in new["runs"]}
     if set(then) != set(now):
         gone, added = sorted(set(then) - set(now)), sorted(set(now) - set(then))
@@ -234,6 +244,12 @@ def _plan_difference(old: dict[str, Any], new: dict[str, Any]) -> str:
         if _canonical(before) != _canonical(run):
             return _run_difference(run_id, before, run)
     return ""
+
+
+def _renamed_run(run: dict[str, Any]) -> dict[str, Any]:
+    """A planned run of ``plan.json`` with its overrides' keys under today's names."""
+    overrides = run.get("overrides")
+    return {**run, "overrides": migrate_dotted(overrides)} if isinstance(overrides, dict) else run
 
 
 def _run_difference(run_id: str, before: dict[str, Any], now: dict[str, Any]) -> str:
@@ -265,7 +281,8 @@ def _verify(
             raise ConfigError(changed(spec, out, what, finished))
         if bad := _unlike(row, row_cells(job_of(spec, run))):
             raise ConfigError(changed(spec, out, f"finished run {run_id} has {bad}", finished))
-        change = scenario_change(spec, out, run)
+        compared = scenario_change(spec, out, run)
+        change = compared.change
         if change is None:
             notes.append(
                 f"{out / RUNS_DIR / run_id} has no readable {SCENARIO_FILE} to tell which "
@@ -275,6 +292,7 @@ def _verify(
         if change:
             what = f"the scenario of finished run {run_id} changed ({change})"
             raise ConfigError(changed(spec, out, what, finished))
+        notes += [note for note in compared.notes if note not in notes]
         if not done and (note := gained_since(spec, out, run, finished)):
             notes.append(note)  # a package's new section that changes nothing: said once
         done.add(run_id)
@@ -282,104 +300,12 @@ def _verify(
 
 
 def _unlike(row: dict[str, Any], expected: dict[str, Any]) -> str:
-    """``key = value, the study other`` for the first cell of a row unlike the run's, or ""."""
+    """``key = value, the study other`` for the first cell of a row unlike the run's, or "".
+
+    The row's keys are read under today's names (renamed keys of the same meaning).
+    """
+    row = migrate_dotted(row)
     for key, value in expected.items():
         if _canonical(row.get(key)) != _canonical(value):
             return f"{key} = {_canonical(row.get(key))}, the study {_canonical(value)}"
     return ""
-
-
-def _write_text(path: Path, text: str) -> None:
-    """Write ``text`` beside ``path``, then rename: a reader sees the old or the new file."""
-    partial = path.with_name(path.name + PARTIAL)
-    partial.write_text(text, encoding="utf-8")
-    os.replace(partial, path)
-
-
-def prepare(out: Path, state: FolderState) -> None:
-    """Create the folder, write the plan, and clear runs cut short (they run again).
-
-    Raises:
-        ExportError: the folder cannot be written (read-only, full, not a folder).
-    """
-    try:
-        (out / RUNS_DIR).mkdir(parents=True, exist_ok=True)
-        _write_text(out / PLAN_FILE, state.plan)
-        for folder in (out / RUNS_DIR).iterdir():
-            if folder.name.endswith(PARTIAL):
-                shutil.rmtree(folder)
-    except OSError as error:
-        raise ExportError(f"{out}: cannot write the study folder ({_reason(error)})") from None
-
-
-def write_run(out: Path, outcome: Outcome) -> None:
-    """Write a run's folder: complete, or not at all.
-
-    Raises:
-        ExportError: the folder cannot be written (read-only, full).
-    """
-    run_id = outcome.row["run_id"]
-    final = out / RUNS_DIR / run_id
-    partial = out / RUNS_DIR / f"{run_id}{PARTIAL}"
-    try:
-        _write_run_files(partial, outcome)
-        if final.exists():
-            shutil.rmtree(final)  # an earlier failed attempt, or a garbled row
-        os.replace(partial, final)
-    except OSError as error:
-        shutil.rmtree(partial, ignore_errors=True)  # free what it took
-        raise ExportError(f"{out}: cannot write run {run_id} ({_reason(error)})") from None
-
-
-def _write_run_files(partial: Path, outcome: Outcome) -> None:
-    if partial.exists():
-        shutil.rmtree(partial)
-    partial.mkdir(parents=True)
-    if outcome.scenario_toml:
-        (partial / SCENARIO_FILE).write_text(outcome.scenario_toml)
-    if outcome.summary:
-        (partial / "summary.json").write_text(json.dumps(outcome.summary, indent=2) + "\n")
-    if outcome.tables:
-        (partial / "tables").mkdir()
-        for name, data in outcome.tables.items():
-            (partial / "tables" / f"{name}.parquet").write_bytes(data)
-    if outcome.failure:
-        (partial / FAILURE_FILE).write_text(outcome.failure)
-    (partial / ROW_FILE).write_text(json.dumps(outcome.row, indent=1, default=str) + "\n")
-
-
-def finished_rows(spec: StudySpec, out: Path) -> list[dict[str, Any]]:
-    """The readable rows of the study's runs, in plan order."""
-    rows = []
-    for run in spec.runs():
-        found = read_row(out / RUNS_DIR / run.run_id / ROW_FILE)
-        if found.row is not None:
-            rows.append(found.row)
-    return rows
-
-
-def collect(spec: StudySpec, out: Path) -> pd.DataFrame:
-    """Assemble ``results.parquet`` from the run folders, in plan order.
-
-    Raises:
-        ExportError: the results cannot be written (read-only, full).
-    """
-    frame = pd.DataFrame(finished_rows(spec, out))
-    if len(frame):
-        write_results(frame, out / RESULTS_FILE)
-    return frame
-
-
-def write_results(frame: pd.DataFrame, path: Path) -> None:
-    """Write a study's results beside ``path``, then rename: a full disk keeps the old file.
-
-    Raises:
-        ExportError: the results cannot be written (read-only, full).
-    """
-    partial = path.with_name(path.name + PARTIAL)
-    try:
-        frame.to_parquet(partial, index=False)
-        os.replace(partial, path)
-    except OSError as error:
-        partial.unlink(missing_ok=True)
-        raise ExportError(f"{path}: cannot write the results ({_reason(error)})") from None

@@ -23,11 +23,11 @@ from cosim.studies.analysis import (
     write_report,
 )
 from cosim.studies.derived import DERIVED_METRICS
-from cosim.studies.folder import write_results
 from cosim.studies.labels import axis_label, short_label
 from cosim.studies.spec import StudySpec
 from cosim.studies.timeseries import timeseries_figures
 from cosim.studies.unset import fill_unset
+from cosim.studies.writing import write_results
 
 DEFAULT_METRICS = (
     "tasks_per_min",

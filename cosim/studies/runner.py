@@ -32,11 +32,12 @@ import pandas as pd
 from cosim.core.errors import CosimError, ExportError, WorkerError
 from cosim.studies.cluster import DEFAULT_TIMEOUT_S, check_scheduler, connect, dask_outcomes
 from cosim.studies.fingerprint import job_of
-from cosim.studies.folder import collect, finished_rows, inspect, prepare, write_run
+from cosim.studies.folder import inspect
 from cosim.studies.lifeline import STUDY_PID_VARIABLE, StudyStopped, bind_worker, signal_name
 from cosim.studies.progress import Progress, StudyProgress
 from cosim.studies.spec import StudySpec
 from cosim.studies.worker import Job, Outcome, run_one
+from cosim.studies.writing import collect, finished_rows, prepare, write_run
 
 if TYPE_CHECKING:
     from cosim.runner.stopping import StopRequest

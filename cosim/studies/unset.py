@@ -18,9 +18,11 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from cosim.core.errors import ConfigError
+from cosim.scenario.migrations import migrate
 from cosim.studies.analysis import RESULTS_FILE, load_results
 from cosim.studies.fingerprint import RUNS_DIR, SCENARIO_FILE
-from cosim.studies.folder import write_results
+from cosim.studies.writing import write_results
 
 NAMED = 10
 """Runs a note names; the others are counted."""
@@ -69,11 +71,15 @@ def fill_unset(study_dir: Path, keys: Sequence[str | None]) -> list[str]:
 
 
 def _scenario(study_dir: Path, run_id: str) -> dict[str, Any] | None:
-    """A run's resolved scenario as TOML tables, or None if it cannot be read."""
+    """A run's resolved scenario as TOML tables, or None if it cannot be read.
+
+    Keys renamed since the run are under their new names (a run of any earlier format
+    is grouped under the value it ran with: :func:`cosim.scenario.migrations.migrate`).
+    """
     path = study_dir / RUNS_DIR / run_id / SCENARIO_FILE
     try:
-        return tomllib.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        return migrate(tomllib.loads(path.read_text(encoding="utf-8")), str(path)).tables
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError, ConfigError):
         return None
 
 

@@ -18,8 +18,10 @@ from adapters.mapping.bagmap import RESOLUTION_M
 from adapters.world.files import read_map
 from cosim.cli.bagmap import map_bag
 from cosim.core.errors import BagError, ExportError
+from cosim.runner.runfolder import MARKER
+from cosim.runner.staging import STAGING_PREFIX
 from tests.adapters.mapping.recordings import Drive, Odom, Scan, drive, write
-from tests.conftest import SHARED_DATA, SMALL, cosim_main
+from tests.conftest import REPO, SHARED_DATA, SMALL, cosim_main
 
 ACES = SHARED_DATA / "aces_lidar"
 
@@ -512,3 +514,48 @@ def test_any_recording_with_any_flags_maps_or_is_refused_in_one_line(
         else:
             assert done.stderr.count("\n") == 1, done.stderr
             assert done.stderr.startswith((f"cosim: error: {bag}: ", "cosim map: error: argument"))
+
+
+# --- a run folder of an earlier format, and the folder's owner --------------------------------
+
+OLD_RUN = REPO / "tests" / "oldruns" / "before-462a048"
+"""A run written at 462a048^ (format 0), with its bag (tests/oldruns/README.md)."""
+ROBOT_1 = ("--scan", "/robot_1/scan", "--odom", "/robot_1/odom")
+
+
+def test_the_bag_of_a_run_of_an_earlier_format_is_mapped_from_its_folder(tmp_path):
+    done = _cli("map", str(OLD_RUN), *ROBOT_1, "--out", str(tmp_path / "m"))
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith("30 scans, ")
+    summary = json.loads((tmp_path / "m" / "summary.json").read_text())
+    assert summary["scans"] == 30 and summary["map_updates"] >= 1
+    assert (tmp_path / "m" / MARKER).read_text().startswith("cosim map folder")
+    info = _cli("bag", "info", str(OLD_RUN))
+    assert info.returncode == 0, info.stderr
+    assert f"bag:       {OLD_RUN / 'bag'}\n" in info.stdout and "messages:  461\n" in info.stdout
+
+
+def test_force_replaces_an_earlier_maps_files_and_nothing_else(tmp_path):
+    out = tmp_path / "m"
+    assert _cli("map", str(OLD_RUN), *ROBOT_1, "--out", str(out)).returncode == 0
+    (out / "notes.txt").write_text("mine")
+    (out / "map.png").write_text("replaced")
+    again = _cli("map", str(OLD_RUN), *ROBOT_1, "--out", str(out), "--force")
+    assert again.returncode == 0, again.stderr
+    assert (out / "notes.txt").read_text() == "mine"
+    assert (out / "map.png").read_bytes().startswith(b"\x89PNG")
+    assert not [p for p in out.iterdir() if p.name.startswith(STAGING_PREFIX)]
+
+
+def test_force_into_a_folder_no_cosim_map_wrote_is_refused_and_nothing_is_touched(tmp_path):
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "map.png").write_text("my own map")
+    done = _cli("map", str(OLD_RUN), *ROBOT_1, "--out", str(out), "--force")
+    assert done.returncode == 2
+    assert done.stderr == (
+        f"cosim: error: {out}: not a folder of `cosim map` (no .cosim-run, nor its "
+        "summary.json): --force replaces only an earlier map's files; choose another --out\n"
+    )
+    assert [p.name for p in out.iterdir()] == ["map.png"]
+    assert (out / "map.png").read_text() == "my own map"

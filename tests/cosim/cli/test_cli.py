@@ -100,13 +100,20 @@ def test_the_resolved_scenario_reproduces_the_run(tmp_path):
         )
 
 
-def test_run_refuses_a_non_empty_output_folder_unless_forced(tmp_path):
+def test_run_refuses_a_non_empty_output_folder_unless_forced_and_a_run_folder(tmp_path):
     out = tmp_path / "run"
     out.mkdir()
     (out / "notes.txt").write_text("keep me")
     refused = cosim_cli("run", "warehouse-random", "--out", str(out), "--duration-s", "0.5", *SMALL)
     assert refused.returncode == 2
     assert "not empty" in refused.stderr and "--force" in refused.stderr
+    args = ("run", "warehouse-random", "--out", str(out), "--duration-s", "0.5", "--force")
+    mine = cosim_cli(*args, *SMALL)
+    assert mine.returncode == 2 and mine.stderr.count("\n") == 1
+    assert f"{out}: not a run folder (no .cosim-run" in mine.stderr
+    (out / "notes.txt").rename(tmp_path / "notes.txt")
+    assert cosim_cli(*args, "--quiet", *SMALL).returncode == 0  # a run folder now
+    (tmp_path / "notes.txt").rename(out / "notes.txt")
     forced = cosim_cli(
         "run",
         "warehouse-random",

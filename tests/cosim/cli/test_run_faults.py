@@ -20,7 +20,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from cosim.cli.args import build_parser
+from cosim.core.errors import ExportError
 from cosim.core.recorder import MESSAGES
+from cosim.runner.runfolder import RUN_FORMAT
+from cosim.runner.staging import STAGING_PREFIX
 from cosim.scenario.fields import key_bounds
 from cosim.scenario.sections import ScenarioSection
 from tests.conftest import REPO, cosim_main
@@ -125,24 +128,42 @@ def _full_disk(folder: Path, size: str):
                 pytest.fail(f"the run left a file open on the full disk: {unmounted.stderr}")
         return
     full = OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+    unfinished = ExportError(f"{folder}/run/bag: cannot finish the bag ({full})")
     with (
         mock.patch("pandas.DataFrame.to_parquet", side_effect=full),
-        mock.patch("cosim.recording.bag.BagSink.close", side_effect=full),
+        mock.patch("cosim.recording.bag.BagSink.close", side_effect=unfinished),
     ):
         yield folder
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize(("bag", "size"), [("mcap", "64k"), ("none", "12k")])
-def test_a_full_disk_is_one_line_and_leaves_no_half_written_folder(bag, size, tmp_path):
+@pytest.mark.parametrize(("bag", "size"), [("mcap", "64k"), ("sqlite3", "64k"), ("none", "12k")])
+def test_a_full_disk_is_one_line_leaves_nothing_half_written_and_keeps_the_results_elsewhere(
+    bag, size, tmp_path, monkeypatch
+):
+    spare = tmp_path / "spare"  # the system's temporary folder, for this test
+    spare.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(spare))
     with _full_disk(tmp_path / "disk", size) as disk:
         done = cosim_main(
             "run", "warehouse-random", "--duration-s", "20", "--bag", bag, "--out",
             str(disk / "run"), *SMALL,
         )  # fmt: skip
-        assert "No space left on device" in _one_line(done)
+        said = _one_line(done)
+        assert "No space left on device" in said or "disk is full" in said
+        assert said.startswith(f"cosim: error: {disk / 'run'}")
         assert not (disk / "run.partial").exists()
         assert not (disk / "run" / "summary.json").exists()
+        assert not [p for p in (disk / "run").iterdir() if p.name.startswith(STAGING_PREFIX)]
+    kept = list(spare.iterdir())
+    if not kept:  # no small disk could be mounted: the stand-in refuses every table anywhere
+        assert said.endswith("no copy could be kept\n")
+        return
+    (where,) = kept
+    assert said.endswith(f"they are kept in {where}/ instead\n")
+    summary = json.loads((where / "summary.json").read_text())
+    assert summary["format"] == RUN_FORMAT and summary["sim_time_s"] > 0
+    assert len(pd.read_parquet(where / "tables" / "poses.parquet")) > 0
 
 
 @pytest.mark.slow

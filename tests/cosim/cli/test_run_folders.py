@@ -1,8 +1,15 @@
-"""`cosim run`'s folders: default ones that do not collide, --force that keeps the figures."""
+"""`cosim run`'s folders: default ones that do not collide, --force that keeps the figures,
+and every place an --out may be (another device, a read-only parent) keeping the whole run."""
 
+import json
+
+import pandas as pd
 import pytest
 
+from cosim.runner.runfolder import MARKER, RUN_FORMAT
+from cosim.runner.staging import STAGING_PREFIX
 from tests.conftest import cosim_main
+from tests.folders import another_device, cannot_write, read_only_parent
 
 SMALL = [
     *("--set", "world.size_m=[12.0, 12.0]"),
@@ -65,3 +72,64 @@ def test_force_without_figures_keeps_the_figures_a_user_drew_and_says_whose_they
     assert again.stdout.splitlines()[-1] == (
         "figures/: kept from before, not of this run (`cosim plot runs/demo` redraws them)"
     )
+
+
+def _kept_everything(folder, *, bag=False):
+    """Assert ``folder`` holds the whole of a 1 s run: summary, scenario, tables (and bag)."""
+    summary = json.loads((folder / "summary.json").read_text())
+    assert summary["format"] == RUN_FORMAT and summary["sim_time_s"] == 1.0
+    assert (folder / "scenario.toml").is_file() and (folder / MARKER).is_file()
+    assert len(pd.read_parquet(folder / "tables" / "poses.parquet")) > 0
+    assert (folder / "bag" / "metadata.yaml").is_file() == bag
+    assert not [p for p in folder.iterdir() if p.name.startswith(STAGING_PREFIX)]
+
+
+@pytest.mark.slow  # a short run
+def test_a_run_whose_out_links_to_another_device_keeps_everything(tmp_path):
+    with another_device(tmp_path) as device:
+        (tmp_path / "res").symlink_to(device)
+        args = ("run", "warehouse-random", *SMALL, "--bag", "mcap", "--out", "res", "--quiet")
+        done = cosim_main(*args, cwd=tmp_path)
+        assert done.returncode == 0, done.stderr
+        _kept_everything(device, bag=True)
+    assert [p.name for p in tmp_path.iterdir()] == ["res"]
+
+
+@pytest.mark.slow  # a short run
+def test_a_run_into_a_writable_folder_in_a_read_only_one_keeps_everything(tmp_path):
+    with read_only_parent(tmp_path) as out:
+        assert cannot_write(out.parent)
+        done = cosim_main("run", "warehouse-random", *SMALL, "--out", str(out), "--quiet")
+        assert done.returncode == 0, done.stderr
+        _kept_everything(out)
+
+
+@pytest.mark.slow  # a short run
+def test_a_run_leaves_a_file_out_partial_and_a_users_folder_res_partial_untouched(tmp_path):
+    (tmp_path / "res.partial").mkdir()
+    (tmp_path / "res.partial" / "notes.txt").write_text("mine")
+    (tmp_path / "other.partial").write_text("mine too")
+    for out in ("res", "other"):
+        done = cosim_main("run", "warehouse-random", *SMALL, "--out", out, "--quiet", cwd=tmp_path)
+        assert done.returncode == 0, done.stderr
+        _kept_everything(tmp_path / out)
+    assert (tmp_path / "res.partial" / "notes.txt").read_text() == "mine"
+    assert [p.name for p in (tmp_path / "res.partial").iterdir()] == ["notes.txt"]
+    assert (tmp_path / "other.partial").read_text() == "mine too"
+
+
+@pytest.mark.slow  # a short run
+def test_force_into_a_folder_cosim_did_not_write_is_refused_in_one_line(tmp_path):
+    mine = tmp_path / "thesis"
+    (mine / "tables").mkdir(parents=True)
+    (mine / "tables" / "poses.parquet").write_text("my own poses")
+    (mine / "summary.json").write_text("{}")
+    done = cosim_main("run", "warehouse-random", *SMALL, "--out", "thesis", "--force", cwd=tmp_path)
+    assert done.returncode == 2
+    assert done.stderr == (
+        "cosim: error: thesis: not a run folder (no .cosim-run, nor the summary.json and "
+        "scenario.toml of a run): --force replaces only an earlier run's files; choose another "
+        "--out\n"
+    )
+    assert (mine / "tables" / "poses.parquet").read_text() == "my own poses"
+    assert sorted(p.name for p in mine.iterdir()) == ["summary.json", "tables"]

@@ -11,8 +11,9 @@ import cosim
 from cosim.core.errors import ConfigError, ExportError
 from cosim.plotting.command import plot_run, snapshot_times
 from cosim.plotting.rundata import load_run
-from tests.conftest import SMALL
+from tests.conftest import REPO, SMALL, cosim_main
 from tests.cosim.plotting.conftest import PNG_MAGIC
+from tests.packages import on_path, write_package
 
 EVERY_FIGURE = ["trajectories.png", "snapshots.png", "tasks.png", "network.png", "assignment.png"]
 MAX_PNG_BYTES = 2_000_000
@@ -176,3 +177,104 @@ def test_an_unwritable_out_folder_is_an_export_error_naming_it(task_run, tmp_pat
     blocker.write_text("a file where the folder should be")
     with pytest.raises(ExportError, match="blocker"):
         plot_run(task_run, out=blocker / "figures")
+
+
+# --- runs of earlier formats, and of plugins no longer installed --------------------------------
+
+OLD_RUNS = REPO / "tests" / "oldruns"
+"""Run folders written by older cosim (tests/oldruns/README.md says how)."""
+
+
+@pytest.mark.parametrize(
+    ("folder", "notes"),
+    [
+        ("at-99e8d54", ""),
+        (
+            "before-462a048",
+            "note: {scenario}: [humans] yield_s = 10.0 read as humans.avoid_robots = true "
+            "(renamed in 462a048: people keep clear of robots through a speed model instead of "
+            "stopping for one at most yield_s s; yield_s = 0 (never stopping) is avoid_robots = "
+            "false)\n",
+        ),
+    ],
+)
+def test_a_run_folder_of_an_earlier_format_is_drawn_saying_how_it_was_read(folder, notes, tmp_path):
+    run = OLD_RUNS / folder
+    done = cosim_main("plot", str(run), "--out", str(tmp_path / "figures"))
+    assert done.returncode == 0, done.stderr
+    assert done.stderr == notes.format(scenario=run / "scenario.toml")
+    assert sorted(p.name for p in (tmp_path / "figures").iterdir()) == sorted(EVERY_FIGURE)
+    _assert_bounded_pngs(list((tmp_path / "figures").iterdir()))
+
+
+ODOKIT = '''"""A lab's odometer: its own settings section, its own table."""
+
+from dataclasses import dataclass
+
+from cosim.core.hosts import HostId
+from cosim.scenario.fields import param
+
+
+@dataclass(frozen=True)
+class OdometerSettings:
+    """``[odometer]``: counting robot_1's odometry."""
+
+    every: int = param(1, "count every n-th message", ge=1)
+
+
+class Odometer:
+    name = "odometer"
+    requires = ("fleet",)
+
+    def __init__(self, run):
+        self.every = run.scenario.section(OdometerSettings).every
+        self.count = 0
+        self.table = run.recorder.table("odometer", ("t_s", "count"))
+
+    def start(self, run):
+        def on_odom(message, envelope):
+            self.count += 1
+            if self.count % self.every == 0:
+                self.table.append(t_s=run.kernel.now_ns / 1e9, count=self.count)
+
+        run.bus.subscribe("/robot_1/odom", HostId("robot_1"), on_odom)
+
+    def finish(self, run):
+        return {"odometer_messages": self.count}
+'''
+
+
+@pytest.mark.slow  # a short run with the plugin, then the same folder read without it
+def test_a_run_made_with_a_plugin_since_uninstalled_is_drawn_and_refused_as_a_scenario(tmp_path):
+    entry_points = {
+        "cosim.adapters": {"odometer": "odokit.odometer:Odometer"},
+        "cosim.sections": {"odometer": "odokit.odometer:OdometerSettings"},
+    }
+    site = write_package(
+        tmp_path / "site", "odokit", "0.2.0", entry_points, {"odokit/odometer.py": ODOKIT}
+    )
+    run = tmp_path / "run"
+    with on_path(site):
+        scenario = cosim.load_scenario(
+            "warehouse-random",
+            {**SMALL, "scenario.adapters": ["odometer"], "odometer.every": 2},
+        )
+        cosim.run(scenario, duration_s=1.0, out=run)
+    assert len(pd.read_parquet(run / "tables" / "odometer.parquet")) == 10
+    done = cosim_main("plot", str(run), "--out", str(tmp_path / "figures"))
+    assert done.returncode == 0, done.stderr
+    assert done.stderr == (
+        f"note: {run / 'scenario.toml'}: [odometer], scenario.adapters = ['odometer'] carried "
+        "unread: no installed package provides them (the run used odokit 0.2.0); the run's "
+        "tables are read without it\n"
+    )
+    assert (tmp_path / "figures" / "trajectories.png").is_file()
+    again = cosim_main("run", str(run / "scenario.toml"), "--out", str(tmp_path / "again"))
+    assert again.returncode == 2 and again.stderr.count("\n") == 1, again.stderr
+    assert again.stderr == (
+        f"cosim: error: {run / 'scenario.toml'}: unknown section [odometer]: no installed "
+        "package registers it; the file was resolved with odokit 0.2.0, not installed here: "
+        "install it to run this scenario (`cosim plot` and studies' reports read a run's "
+        "tables without it)\n"
+    )
+    assert not (tmp_path / "again").exists()

@@ -1,5 +1,9 @@
+import errno
+import json
+import os
 from collections.abc import Mapping
 from typing import Any, ClassVar
+from unittest import mock
 
 import numpy as np
 import pandas as pd
@@ -7,9 +11,11 @@ import pytest
 
 import cosim
 from cosim.core.adapter import RunContext
+from cosim.core.errors import ConfigError, ExportError
 from cosim.core.hosts import HostId
 from cosim.core.kernel import Stage
 from cosim.core.registry import AdapterRegistry
+from cosim.recording.bag import BagSink
 from cosim.runner.assembly import adapter_names
 from cosim.runner.execute import execute
 
@@ -184,3 +190,67 @@ def test_an_adapter_missing_finish_is_refused_before_the_run_naming_it(small_sce
 def test_an_unknown_adapter_name_given_to_run_suggests_the_nearest(small_scenario):
     with pytest.raises(cosim.RegistryError, match=r"unknown adapter 'lidr'; did you mean 'lidar'"):
         cosim.run(small_scenario, adapters=["lidr"])
+
+
+# --- a full disk under the bag, and a scenario read to draw a run -------------------------------
+
+
+def test_a_bag_that_cannot_be_finished_keeps_the_rest_of_the_run(small_scenario, tmp_path):
+    out = tmp_path / "run"
+    full = ExportError(f"{out}/bag: cannot finish the bag (No space left on device)")
+    with (
+        mock.patch("cosim.recording.bag.BagSink.close", side_effect=full),
+        pytest.raises(ExportError) as refused,
+    ):
+        cosim.run(small_scenario, duration_s=1.0, out=out)
+    assert str(refused.value) == (
+        f"{out}/bag: cannot finish the bag (No space left on device); the results of the 1 s "
+        f"simulated are in {out}/"
+    )
+    assert refused.value.kept.out == out
+    assert json.loads((out / "summary.json").read_text())["sim_time_s"] == 1.0
+    assert len(pd.read_parquet(out / "tables" / "poses.parquet")) > 0
+
+
+def test_a_disk_that_fills_under_the_bag_mid_run_ends_the_run_keeping_what_ran(
+    small_scenario, tmp_path
+):
+    out = tmp_path / "run"
+    real_open = BagSink.open
+
+    def open_on_a_filling_disk(self, *args, **kwargs):
+        real_open(self, *args, **kwargs)
+        store, calls = self._store, [0]
+
+        def store_until_full(*stored):
+            calls[0] += 1
+            if calls[0] > 200:
+                raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+            return store(*stored)
+
+        self._store = store_until_full
+
+    with (
+        mock.patch.object(BagSink, "open", open_on_a_filling_disk),
+        mock.patch.object(BagSink, "close"),  # the bag's end would not fit either
+        pytest.raises(ExportError) as refused,
+    ):
+        cosim.run(small_scenario, out=out)
+    said = str(refused.value)
+    assert said.startswith(f"{out}/bag: cannot write the bag ([Errno 28] No space left on device)")
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["failure"]["kind"] == "external" and 0 < summary["sim_time_s"] < 3.0
+    assert said.endswith(
+        f"the results of the {summary['sim_time_s']:g} s simulated are in {out}/ "
+        '(summary.json says "failed")'
+    )
+    assert not (out / "failure.txt").exists()  # a full disk is no code's fault: no traceback
+
+
+def test_a_scenario_read_with_a_plugins_section_it_cannot_load_is_not_run(tmp_path):
+    path = tmp_path / "scenario.toml"
+    path.write_text('[provenance]\ngone = "1.0"\n\n[odometer]\nevery = 2\n')
+    scenario = cosim.load_scenario(path, reading=True)
+    with pytest.raises(ConfigError, match=r"unknown section \[odometer\]: .*install gone 1\.0"):
+        cosim.run(scenario, out=tmp_path / "run")
+    assert not (tmp_path / "run").exists()

@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 import cosim
 from cosim.cli.main import main
 from cosim.core.errors import CosimError
+from cosim.scenario import dump_scenario
 from cosim.scenario.loader import section_types
 from cosim.studies import load_study
 
@@ -102,6 +103,39 @@ def test_any_scenario_document_loads_or_is_refused_in_one_line_naming_the_file(d
         cosim.load_scenario(path)
     except CosimError as error:
         _one_line(str(error), str(path))
+
+
+OLD_KEYS = [("humans", "yield_s"), ("provenance", "gonekit")]
+"""Keys an older run's scenario.toml may have: renamed since, a package no longer installed."""
+
+
+@st.composite
+def old_documents(draw):
+    doc = draw(documents())
+    for _ in range(draw(st.integers(0, 2))):
+        section, key = draw(st.sampled_from(OLD_KEYS))
+        doc.setdefault(section, {})[key] = draw(st.one_of(values, st.sampled_from([0, 10.0, "1"])))
+    return doc
+
+
+@pytest.mark.slow
+@settings(
+    max_examples=300, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(doc=old_documents())
+def test_any_older_runs_scenario_reads_and_dumps_back_or_is_refused_in_one_line(doc, tmp_path):
+    path = tmp_path / "scenario.toml"
+    path.write_text(toml_document(doc), encoding="utf-8", errors="surrogatepass")
+    try:
+        scenario = cosim.load_scenario(path, reading=True)
+    except CosimError as error:
+        _one_line(str(error), str(path))
+        return
+    for note in scenario.notes:
+        _one_line(note, str(path))
+    again = tmp_path / "again.toml"
+    again.write_text(dump_scenario(scenario), encoding="utf-8", errors="surrogatepass")
+    assert cosim.load_scenario(again, reading=True) == scenario
 
 
 @settings(

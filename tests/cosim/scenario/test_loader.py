@@ -1,10 +1,14 @@
+import math
 from pathlib import Path
 
 import pytest
 
 import cosim
+import cosim.scenario.migrations as migrations
+from adapters.assignment.settings import AssignmentConfig
 from cosim.core.errors import ConfigError
 from cosim.scenario import dump_scenario, parse_override, preset_names, scenario_from_text
+from cosim.scenario.loader import check_runnable
 
 
 def _write(tmp_path: Path, text: str) -> Path:
@@ -212,3 +216,120 @@ def test_an_unknown_key_inside_a_partition_is_named_with_its_index():
         cosim.load_scenario(
             "warehouse-random", {"network.partitions": [{"form_s": 1.0, "to_s": 2.0}]}
         )
+
+
+# --- the scenario of an older run, read to draw it ---------------------------------------------
+
+
+def test_a_renamed_key_whose_model_changed_is_refused_naming_the_new_key(tmp_path):
+    path = _write(tmp_path, "[humans]\nworkers = 2\nyield_s = 10.0\n")
+    with pytest.raises(ConfigError) as refused:
+        cosim.load_scenario(path)
+    assert str(refused.value) == (
+        f"{path}: [humans] unknown key 'yield_s': renamed humans.avoid_robots in 462a048 "
+        "(people keep clear of robots through a speed model instead of stopping for one at "
+        "most yield_s s; yield_s = 0 (never stopping) is avoid_robots = false); set "
+        "humans.avoid_robots instead"
+    )
+    with pytest.raises(ConfigError, match=r"^--set humans\.yield_s: \[humans\] unknown key"):
+        cosim.load_scenario("warehouse-random", {"humans.yield_s": 3.0})
+
+
+def test_a_run_read_for_its_results_takes_the_renamed_key_with_a_note(tmp_path):
+    path = _write(tmp_path, "[humans]\nworkers = 2\nyield_s = 0.0\n")
+    scenario = cosim.load_scenario(path, reading=True)
+    assert scenario.humans.avoid_robots is False and scenario.humans.workers == 2
+    assert scenario.notes == (
+        f"note: {path}: [humans] yield_s = 0.0 read as humans.avoid_robots = false (renamed "
+        "in 462a048: people keep clear of robots through a speed model instead of stopping for "
+        "one at most yield_s s; yield_s = 0 (never stopping) is avoid_robots = false)",
+    )
+
+
+def test_a_renamed_key_of_the_same_meaning_runs_with_a_note(tmp_path, monkeypatch):
+    same = migrations.Rename("lidar.rays", "lidar.beams", "0000000", int, True, "the same")
+    monkeypatch.setattr(migrations, "RENAMES", (*migrations.RENAMES, same))
+    path = _write(tmp_path, "[lidar]\nrays = 90\n")
+    scenario = cosim.load_scenario(path)
+    assert scenario.lidar.beams == 90
+    assert scenario.notes == (
+        f"note: {path}: [lidar] rays = 90 read as lidar.beams = 90 (renamed in 0000000: the same)",
+    )
+    with pytest.raises(ConfigError, match=rf"^{path}: \[lidar\] beams = -5: expected"):
+        cosim.load_scenario(_write(tmp_path, "[lidar]\nrays = -5\n"))  # named where it came from
+
+
+ODOKIT = """# resolved from preset warehouse-random
+
+[provenance]
+cosim = "0.1.0"
+odokit = "0.3.0"
+
+[scenario]
+adapters = ["odometer"]
+
+[assignment]
+protocol = "sealed_bid"
+
+[odometer]
+rate_hz = 5.0
+wheels = [1, 2]
+"""
+
+
+def test_a_section_of_a_plugin_not_installed_any_more_is_refused_naming_the_package(tmp_path):
+    path = _write(tmp_path, ODOKIT)
+    with pytest.raises(ConfigError) as refused:
+        cosim.load_scenario(path)
+    assert str(refused.value) == (
+        f"{path}: unknown section [odometer]: no installed package registers it; the file was "
+        "resolved with odokit 0.3.0, not installed here: install it to run this scenario "
+        "(`cosim plot` and studies' reports read a run's tables without it)"
+    )
+
+
+def test_sections_and_names_of_a_plugin_not_installed_are_carried_where_a_run_is_read(tmp_path):
+    path = _write(tmp_path, ODOKIT)
+    scenario = cosim.load_scenario(path, reading=True)
+    assert dict(scenario.carried) == {"odometer": {"rate_hz": 5.0, "wheels": [1, 2]}}
+    assert scenario.scenario.adapters == ("odometer",)
+    assert scenario.section(AssignmentConfig).protocol == "sealed_bid"
+    assert scenario.notes == (
+        f"note: {path}: [odometer], scenario.adapters = ['odometer'], assignment.protocol = "
+        "'sealed_bid' carried unread: no installed package provides them (the run used "
+        "odokit 0.3.0); the run's tables are read without it",
+    )
+    dumped = dump_scenario(scenario)
+    assert dumped.endswith("\n[odometer]\nrate_hz = 5.0\nwheels = [1, 2]\n")
+    again = cosim.load_scenario(_write(tmp_path, dumped), reading=True)
+    assert again == scenario
+    with pytest.raises(ConfigError) as refused:
+        check_runnable(scenario)
+    assert str(refused.value) == (
+        f"{path}: unknown section [odometer]: no installed package registers it; it was read "
+        "to draw a run, not to run one (install odokit 0.3.0 to run it)"
+    )
+
+
+def test_an_unknown_section_without_provenance_still_gets_a_suggestion(tmp_path):
+    path = _write(tmp_path, '[provenance]\ncosim = "0.1.0"\n\n[robot]\ncount = 2\n')
+    with pytest.raises(ConfigError, match=r"unknown section \[robot\]; did you mean 'robots'"):
+        cosim.load_scenario(path)
+
+
+def test_a_carried_section_keeps_what_toml_can_say_through_a_dump(tmp_path):
+    text = (
+        "[gone]\nx = nan\ny = [inf, -inf]\nwhen = 2026-11-28T10:00:00Z\nday = 2026-11-28\n"
+        'at = 07:32:00\n"odd key" = {a = 1, "b\\nc" = "d\\u0000"}\n'
+    )
+    scenario = cosim.load_scenario(_write(tmp_path, text), reading=True)
+    dumped = dump_scenario(scenario)
+    assert "\n[gone]\nx = nan\ny = [inf, -inf]\nwhen = 2026-11-28T10:00:00+00:00\n" in dumped
+    again = cosim.load_scenario(_write(tmp_path, dumped), reading=True).carried["gone"]
+    assert again["when"] == scenario.carried["gone"]["when"]
+    assert (
+        again["day"] == scenario.carried["gone"]["day"]
+        and again["at"] == scenario.carried["gone"]["at"]
+    )
+    assert again["odd key"] == {"a": 1, "b\nc": "d\x00"}
+    assert again["x"] != again["x"] and again["y"] == [math.inf, -math.inf]

@@ -5,6 +5,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from cosim.runner.staging import STAGING_PREFIX
+
 SCENARIO = """\
 [scenario]
 name = "small"
@@ -77,11 +79,16 @@ def scenario_file(folder: Path, name: str = "scenario.toml") -> Path:
 
 
 def finished(out: Path) -> list[str]:
-    """The run folders of a study folder that are complete (not ``.partial``), sorted."""
+    """The run folders of a study folder that are complete (not a run's on its way), sorted."""
     runs = out / "runs"
     if not runs.is_dir():
         return []
-    return sorted(p.name for p in runs.iterdir() if p.is_dir() and not p.name.endswith(".partial"))
+    return sorted(p.name for p in runs.iterdir() if p.is_dir() and not on_its_way(p))
+
+
+def on_its_way(path: Path) -> bool:
+    """Whether ``path`` is a run folder being written (``runs/.cosim-partial-*``)."""
+    return path.name.startswith(STAGING_PREFIX)
 
 
 def row_times(out: Path) -> dict[str, int]:

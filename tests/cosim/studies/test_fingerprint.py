@@ -12,9 +12,10 @@ import pytest
 from cosim.core.errors import ConfigError
 from cosim.scenario.loader import dump_scenario
 from cosim.studies import load_study
-from cosim.studies.fingerprint import RUNS_DIR, fingerprint, job_of
-from cosim.studies.folder import PLAN_FILE, inspect, prepare, write_run
+from cosim.studies.fingerprint import PLAN_FILE, RUNS_DIR, fingerprint, job_of
+from cosim.studies.folder import inspect
 from cosim.studies.worker import Outcome, job_scenario, row_cells
+from cosim.studies.writing import prepare, write_run
 from tests.conftest import cosim_main
 from tests.cosim.studies.small import finished, row_times, scenario_file, small_study
 from tests.cosim.studies.test_gained import install

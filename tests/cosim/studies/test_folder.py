@@ -10,10 +10,18 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
+import cosim.scenario.migrations as migrations
 import cosim.studies.folder as folder_module
+import cosim.studies.writing as writing_module
 from cosim.studies import load_study
 from tests.conftest import cosim_main
-from tests.cosim.studies.small import finished, row_times, scenario_file, small_study
+from tests.cosim.studies.small import (
+    finished,
+    on_its_way,
+    row_times,
+    scenario_file,
+    small_study,
+)
 
 RUNS = ["0000_s1", "0000_s2", "0000_s3"]
 
@@ -211,7 +219,7 @@ def test_a_full_disk_mid_study_exits_2_in_one_line_and_keeps_the_finished_runs(
     # scenario): one run fits
     disk = tmpfs(32)
     if disk is None:
-        _full_after(monkeypatch, folder_module, "_write_run_files", 2)
+        _full_after(monkeypatch, writing_module, "_write_run_files", 2)
     out = (disk or tmp_path) / "out"
     done = cosim_main("study", str(path), "--out", str(out), "--workers", "1", "--quiet")
     assert done.returncode == 2, done.stdout
@@ -224,7 +232,7 @@ def test_a_full_disk_mid_study_exits_2_in_one_line_and_keeps_the_finished_runs(
         f"the {len(kept)} finished runs are kept in {out}: free space or fix the folder, then "
         "continue with --resume\n"
     )
-    assert not list((out / "runs").glob("*.partial"))  # the failed run's space is freed
+    assert not [p for p in (out / "runs").iterdir() if on_its_way(p)]  # its space is freed
     times = row_times(out)
     _grow(disk, monkeypatch)
     resumed = cosim_main("study", str(path), "--out", str(out), "--workers", "1", "--resume")
@@ -270,3 +278,75 @@ def test_the_plan_names_the_runs_and_the_fingerprint_of_the_scenario(tmp_path):
     assert [r["run_id"] for r in plan["runs"]] == RUNS
     assert plan["scenario"] == str(tmp_path / "scenario.toml")
     assert len(plan["fingerprint"]["scenario"]) == 64
+
+
+# --- runs of earlier formats --------------------------------------------------------------------
+
+
+def _as_written_before(out: Path, old: str, new: str) -> None:
+    """Make the finished runs' scenario.toml and the plan look as an older cosim wrote them."""
+    for run_id in RUNS:
+        path = out / "runs" / run_id / "scenario.toml"
+        text = path.read_text()
+        assert new in text
+        path.write_text(text.replace(new, old))
+        summary = out / "runs" / run_id / "summary.json"
+        found = json.loads(summary.read_text())
+        found.pop("format")
+        summary.write_text(json.dumps(found))
+    plan = json.loads((out / "plan.json").read_text())
+    plan["fingerprint"]["scenario"] = "0" * 64  # what an older cosim's dump hashed to
+    (out / "plan.json").write_text(json.dumps(plan))
+
+
+@pytest.mark.slow
+def test_resuming_runs_of_before_a_rename_of_the_same_meaning_continues_with_a_note(
+    tmp_path, monkeypatch
+):
+    rename = migrations.Rename("robots.number", "robots.count", "0000000", int, True, "same")
+    monkeypatch.setattr(migrations, "RENAMES", (*migrations.RENAMES, rename))
+    out = tmp_path / "out"
+    path, _ = _study(tmp_path, out)
+    times = row_times(out)
+    _as_written_before(out, "\n[robots]\nnumber = 2\n", "\n[robots]\ncount = 2\n")
+    done = cosim_main("study", str(path), "--out", str(out), "--workers", "1", "--resume")
+    assert done.returncode == 0, done.stderr
+    assert f"study: {out / 'plan.json'}: the scenario differs from the plan's only by keys " in (
+        done.stderr
+    )
+    assert "[robots] number = 2 read as robots.count = 2 (renamed in 0000000: same)" in (
+        done.stderr
+    )
+    assert "resuming, 3/3 runs already done" in done.stderr
+    assert row_times(out) == times  # none run again
+
+
+@pytest.mark.slow
+def test_resuming_runs_of_before_yield_s_was_renamed_is_refused_naming_the_rename(tmp_path):
+    out = tmp_path / "out"
+    path, _ = _study(tmp_path, out)
+    times = row_times(out)
+    _as_written_before(out, "\nyield_s = 10.0\n", "\navoid_robots = true\n")
+    done = _resume(path, out)
+    assert done.returncode == 2 and done.stderr.count("\n") == 1, done.stderr
+    assert (
+        "changed (run 0000_s1: humans.yield_s = 10.0 then, renamed humans.avoid_robots in "
+        "462a048: people keep clear of robots"
+    ) in done.stderr
+    assert row_times(out) == times
+    (out / "plan.json").unlink()  # the plan lost: the runs are the evidence, read the same way
+    done = _resume(path, out)
+    assert done.returncode == 2 and len(_errors(done.stderr)) == 1, done.stderr
+    assert "finished run 0000_s1 changed (humans.yield_s = 10.0 then, renamed" in done.stderr
+
+
+def test_a_run_folder_of_a_newer_format_stops_the_resume_in_one_line(tmp_path):
+    path = small_study(tmp_path)
+    out = tmp_path / "out"
+    (out / "runs" / "0000_s1").mkdir(parents=True)
+    (out / "runs" / "0000_s1" / "summary.json").write_text(json.dumps({"format": 99}))
+    done = cosim_main("study", str(path), "--out", str(out), "--workers", "1", "--resume")
+    assert done.returncode == 2 and done.stderr.count("\n") == 1, done.stderr
+    assert f"{out / 'runs' / '0000_s1'}: a run folder of format 99, written by a newer cosim" in (
+        done.stderr
+    )

@@ -72,9 +72,12 @@ def _damage(out: Path, how: str, run: str, junk: bytes) -> None:
         _put(runs / run / "scenario.toml", junk)
     elif how == "delete run":
         _remove(runs / run)
-    elif how == "partial run":
+    elif how == "partial run":  # as cosim wrote a run on its way before run folders had formats
         _put(runs / f"{run}.partial", None)
         _put(runs / f"{run}.partial" / "row.json", junk)
+    elif how == "staged run":  # a run on its way, cut short
+        _put(runs / ".cosim-partial-a1b2c3d4", None)
+        _put(runs / ".cosim-partial-a1b2c3d4" / "row.json", junk)
     elif how == "stray files":
         _put(out / "notes.txt", junk)
         _put(runs / "README", junk)
@@ -85,7 +88,7 @@ def _damage(out: Path, how: str, run: str, junk: bytes) -> None:
 
 DAMAGES = ["delete plan", "garble plan", "plan is a folder", "garble row", "cut row"]
 DAMAGES += ["delete row", "row is a folder", "delete scenario", "garble scenario"]
-DAMAGES += ["delete run", "partial run", "stray files", "runs is a file"]
+DAMAGES += ["delete run", "partial run", "staged run", "stray files", "runs is a file"]
 damages = st.lists(
     st.tuples(
         st.sampled_from(DAMAGES),

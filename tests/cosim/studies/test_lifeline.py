@@ -17,7 +17,7 @@ from cosim.studies.lifeline import STUDY_PID_VARIABLE, StudyStopped, signal_name
 from tests.conftest import cosim_main
 from tests.cosim.studies.busy import SHORT_RUN as BUSY_SHORT_RUN
 from tests.cosim.studies.busy import busy_study
-from tests.cosim.studies.small import finished, small_study
+from tests.cosim.studies.small import finished, on_its_way, small_study
 
 # two short runs, then two long ones: a signal sent once the short ones are written lands
 # while both workers are inside a long run
@@ -90,7 +90,8 @@ def test_sigterm_stops_a_study_at_once_in_one_line_and_resume_completes_it(tmp_p
     )
     kept = pd.read_parquet(out / "results.parquet")
     assert list(kept["run_id"]) == SHORT_RUNS and set(kept["status"]) == {"ok"}
-    assert finished(out) == SHORT_RUNS and not list((out / "runs").glob("*.partial"))
+    assert finished(out) == SHORT_RUNS
+    assert not [p for p in (out / "runs").iterdir() if on_its_way(p)]
     assert workers and not _running(workers)
     resumed = cosim_main("study", str(path), "--out", str(out), "--workers", "2", "--resume")
     assert resumed.returncode == 0, resumed.stderr
@@ -203,7 +204,8 @@ def test_sigterm_at_any_moment_of_collision_checking_stops_the_study_every_time(
         )
         kept = pd.read_parquet(out / "results.parquet")
         assert list(kept["run_id"]) == [BUSY_SHORT_RUN] and list(kept["status"]) == ["ok"]
-        assert finished(out) == [BUSY_SHORT_RUN] and not list((out / "runs").glob("*.partial"))
+        assert finished(out) == [BUSY_SHORT_RUN]
+        assert not [p for p in (out / "runs").iterdir() if on_its_way(p)]
 
 
 def test_inside_a_run_of_the_study_process_a_signal_is_noted_and_raised_where_it_is_looked_for():

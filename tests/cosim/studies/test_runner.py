@@ -15,6 +15,7 @@ from cosim.core.errors import ConfigError
 from cosim.studies import load_study, run_study
 from cosim.studies.worker import VOLATILE_METRICS, Outcome
 from tests.conftest import REPO, cosim_main
+from tests.cosim.studies.small import on_its_way
 from tests.dask_cluster import dask_cluster as start_dask_cluster
 
 TINY = """
@@ -132,15 +133,13 @@ def test_a_study_killed_mid_way_and_resumed_has_every_run_exactly_once(tmp_path)
     deadline = time.monotonic() + 120
     runs = out / "runs"
     while time.monotonic() < deadline:
-        finished = (
-            [p for p in runs.glob("*") if not p.name.endswith(".partial")] if runs.exists() else []
-        )
+        finished = [p for p in runs.iterdir() if not on_its_way(p)] if runs.exists() else []
         if len(finished) >= 2:
             break
         time.sleep(0.05)
     proc.send_signal(signal.SIGKILL)
     proc.wait()
-    killed_with = len([p for p in runs.glob("*") if not p.name.endswith(".partial")])
+    killed_with = len([p for p in runs.iterdir() if not on_its_way(p)])
     assert 2 <= killed_with < 8
     refused = cli("study", str(path), "--out", str(out))
     assert refused.returncode == 2 and "--resume" in refused.stderr
@@ -151,7 +150,7 @@ def test_a_study_killed_mid_way_and_resumed_has_every_run_exactly_once(tmp_path)
     results = pd.read_parquet(out / "results.parquet")
     assert sorted(results["run_id"]) == sorted(r.run_id for r in load_study(path).runs())
     assert results["run_id"].is_unique
-    assert not list(runs.glob("*.partial"))
+    assert not [p for p in runs.iterdir() if on_its_way(p)]
     assert len(list(runs.iterdir())) == 8
 
 
@@ -167,7 +166,7 @@ def test_a_local_worker_process_killed_stops_the_study_cleanly_and_resume_finish
     )
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and not [
-        p for p in (out / "runs").glob("*") if not p.name.endswith(".partial")
+        p for p in (out / "runs").glob("*") if not on_its_way(p)
     ]:
         time.sleep(0.05)
     # the pool's workers are the fork server's children, the study's grandchildren

@@ -145,3 +145,15 @@ def test_failed_runs_are_not_filled_nor_named(tmp_path):
     folder = _folder(tmp_path, rows)
     assert fill_unset(folder, [X]) == []
     assert pd.read_parquet(folder / "results.parquet")[X].isna().tolist() == [False, True]
+
+
+def test_a_run_of_before_a_rename_is_grouped_under_the_new_keys_value(tmp_path):
+    (tmp_path / "runs" / "0000_s1").mkdir(parents=True)
+    (tmp_path / "runs" / "0000_s1" / "scenario.toml").write_text("[humans]\nyield_s = 0.0\n")
+    results = pd.DataFrame(
+        {"run_id": ["0000_s1"], "seed": [1], "status": ["ok"], "humans.avoid_robots": [None]}
+    )
+    results.to_parquet(tmp_path / "results.parquet")
+    assert fill_unset(tmp_path, ["humans.avoid_robots"]) == []
+    filled = pd.read_parquet(tmp_path / "results.parquet")
+    assert filled["humans.avoid_robots"].tolist() == [False]
