@@ -8,7 +8,7 @@ from cosim.core.recorder import EVENTS, MESSAGES
 from cosim.core.registry import installed_groups
 from cosim.core.table import TableSpec
 from cosim.reference.escaping import cell, code, text
-from cosim.runner.execute import REALTIME
+from cosim.runner.lateness import REALTIME
 from cosim.scenario.fields import unit_of
 
 

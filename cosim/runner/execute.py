@@ -10,16 +10,12 @@ from importlib.metadata import version
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from adapters.unity.server import UnityOptions
 from cosim.core.adapter import AdapterType
 from cosim.core.errors import BridgeError, CosimError, ExportError, RegistryError
-from cosim.core.kernel import Lateness
 from cosim.core.plugins import PluginError, refuse
-from cosim.core.recorder import Recorder, merge_counts
+from cosim.core.recorder import merge_counts
 from cosim.core.registry import AdapterRegistry
-from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S, s_to_ns
 from cosim.recording.dataframes import run_frames
 from cosim.recording.foxglove import LiveOptions
@@ -33,6 +29,7 @@ from cosim.runner.faults import (
     fault_of,
     plugin_faults_named,
 )
+from cosim.runner.lateness import record_lateness
 from cosim.runner.outfolder import prepare_out, write_kept, write_run
 from cosim.runner.provenance import run_plugins
 from cosim.runner.result import RunResult
@@ -359,43 +356,6 @@ def failure_summary(failure: CosimError, planned_s: float, unfinished: list[str]
     if unfinished:
         detail["unfinished_adapters"] = unfinished
     return {"failed": str(failure), "failure": detail, "planned_duration_s": planned_s}
-
-
-REALTIME = TableSpec(
-    "realtime",
-    "Real-time runs only: one row per batch of events due at one simulated instant.",
-    {
-        "t_s": "the batch's simulated instant (s)",
-        "lateness_ms": "wall-clock time past the instant it was due (ms; volatile)",
-        "events": "events processed in the batch",
-    },
-    volatile=("lateness_ms",),
-    units={"events": "count"},
-)
-
-
-def record_lateness(lateness: Lateness, recorder: Recorder) -> dict[str, Any]:
-    """Write ``tables/realtime`` (one row per event batch) and return the summary keys.
-
-    Columns: t_s (the batch's simulated instant), lateness_ms (wall-clock ms past the
-    instant it was due), events (in the batch). Wall-clock figures: volatile. A run stopped
-    in the middle of a batch leaves that batch out (its events were not all counted).
-    """
-    batches = min(len(lateness.t_ns), len(lateness.late_ns), len(lateness.events))
-    late_ms = np.frombuffer(lateness.late_ns, dtype=np.int64)[:batches] / 1e6
-    table = recorder.table(REALTIME)
-    table.extend(
-        t_s=np.frombuffer(lateness.t_ns, dtype=np.int64)[:batches] / NS_PER_S,
-        lateness_ms=late_ms,
-        events=np.frombuffer(lateness.events, dtype=np.int64)[:batches],
-    )
-    if late_ms.size == 0:
-        return {"max_lateness_ms": None, "p99_lateness_ms": None, "late_batches": 0}
-    return {
-        "max_lateness_ms": round(float(late_ms.max()), 3),
-        "p99_lateness_ms": round(float(np.percentile(late_ms, 99)), 3),
-        "late_batches": int((late_ms > 1.0).sum()),
-    }
 
 
 def run(

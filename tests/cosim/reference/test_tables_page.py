@@ -16,7 +16,7 @@ from cosim.reference.tables_page import (
     documented_tables,
     tables_markdown,
 )
-from cosim.runner.execute import REALTIME
+from cosim.runner.lateness import REALTIME
 from cosim.scenario.fields import unit_of
 from tests.cosim.reference.rendered import as_shown, rows, shown
 
