@@ -6,11 +6,12 @@ robot (``release``: the robot gave the task up, e.g. stuck; ``conflict``: it gav
 better claim), each naming the task (``task N: ...``). The task source writes ``conflict``
 events too (source ``task_source``, ``task N: robot_3 replaced`` or ``... rejected``): how
 it settled a claim on a task another robot held, which no robot gave up by itself; a
-robot that lost gives way when it hears the better claim, in a ``conflict`` of its own. A claim shows in the navigation table as a goal sent to
-the task's station. From these, each task's holdings: the robots that released it, in
-order, each from its claim to its release, then the robot that served it (or, if none did,
-the robot sent to its station right after the last release or the first claim) up to the
-completion, or to the end of the run if the task was still open.
+robot that lost gives way when it hears the better claim, in a ``conflict`` of its own. A
+claim shows in the navigation table as a goal sent to the task's station. From these, each
+task's holdings: the robots that released it, in order, each from its claim to its
+release, then the robot that served it (or, if none did, the robot sent to its station
+right after the last release or the first claim) up to the completion, or to the end of
+the run if the task was still open.
 """
 
 from __future__ import annotations
