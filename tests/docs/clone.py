@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import sysconfig
@@ -116,15 +117,18 @@ class Clone:
 
     def _run(self, argv: list[str], shown: str, timeout_s: float) -> Ran:
         start = time.monotonic()
-        try:
-            done = subprocess.run(
-                argv, cwd=self.root, env=self.env(), capture_output=True, text=True,
-                timeout=timeout_s, stdin=subprocess.DEVNULL,
-            )  # fmt: skip
-        except subprocess.TimeoutExpired as expired:
-            said = (expired.stdout or b"").decode() if isinstance(expired.stdout, bytes) else ""
-            return Ran(shown, -1, said, f"did not finish within {timeout_s:g} s", timeout_s)
-        return Ran(shown, done.returncode, done.stdout, done.stderr, time.monotonic() - start)
+        # a session of its own: a command that hangs is stopped with every process it started
+        with subprocess.Popen(
+            argv, cwd=self.root, env=self.env(), stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE, text=True, start_new_session=True,
+        ) as process:  # fmt: skip
+            try:
+                stdout, stderr = process.communicate(timeout=timeout_s)
+            except subprocess.TimeoutExpired:
+                os.killpg(process.pid, signal.SIGKILL)
+                stdout, stderr = process.communicate()
+                stderr += f"\n(stopped: no end within {timeout_s:g} s)"
+        return Ran(shown, process.returncode, stdout, stderr, time.monotonic() - start)
 
     def write(self, relative: str, text: str) -> Path:
         """Write ``text`` to ``relative`` in the clone (a linked file is replaced, not followed)."""

@@ -64,7 +64,8 @@ class Part:
 
     A page's slow part begins at its first slow block (:func:`is_slow`) and holds every
     tested block after it but the excerpts (each block needs the blocks before it); the
-    quick part holds the rest.
+    quick part holds the rest. The two may run in different test processes: the slow part
+    then runs the quick blocks before it again, as the steps they are (files, checks).
     """
 
     page: str
@@ -126,16 +127,11 @@ class PageRun:
             self._clone = Clone(self.folder / "cosim")
         return self._clone
 
-    def block(self, line: int) -> Block:
-        """The page's block whose fence opens on ``line``."""
-        (found,) = [b for b in self.blocks if b.line == line]
-        return found
-
     def run_to(self, block: Block) -> list[Ran]:
         """Run the page's blocks up to ``block`` (those not yet run), then ``block``.
 
         Returns:
-            What ``block``'s commands did (empty for a file or Python).
+            What ``block``'s commands, or its Python, did (empty for a file).
 
         Raises:
             pytest.fail.Exception: this block or an earlier one failed (naming it).
@@ -160,13 +156,6 @@ class PageRun:
         if block.skip is not None:
             pytest.skip(f"{block.name}: {block.skip}")
         return self.ran.get(block.index, [])
-
-    def through(self) -> PageRun:
-        """Run every block of the page; the page run, for its outputs."""
-        runnable = [b for b in self.blocks if is_tested(b) and b.skip is None]
-        if runnable:
-            self.run_to(runnable[-1])
-        return self
 
     def python_ran(self) -> list[Ran]:
         """What the page's Python blocks did, in order."""

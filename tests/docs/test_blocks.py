@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+import time
 import tomllib
 from pathlib import Path
 
@@ -160,3 +161,12 @@ def test_a_clone_runs_its_own_cosim_and_knows_no_bare_cosim(tmp_path):
     bare = clone.shell("cosim scenarios")
     assert bare.returncode == 127, bare.told()
     assert (clone.root / "studies").is_dir() and not (clone.root / "studies").is_symlink()
+
+
+def test_a_command_that_does_not_end_is_stopped_with_what_it_started(tmp_path):
+    clone = Clone(tmp_path / "cosim")
+    marker = tmp_path / "still-running"
+    ran = clone.shell(f"(sleep 1; touch {marker}) & sleep 30", timeout_s=0.3)
+    assert ran.returncode != 0 and "no end within 0.3 s" in ran.stderr
+    time.sleep(1.5)
+    assert not marker.exists()  # the background child was stopped too
