@@ -10,7 +10,8 @@ environment the tests run in. Its ``pip.conf`` installs offline and without buil
 (the environment's setuptools builds a page's package); ``.venv/bin/cosim`` is cosim's
 command; ``.venv/.installed`` is the stamp ``make setup`` leaves, so ``make demo`` runs
 without installing again. Commands run in bash with ``PATH`` cleared of any virtual
-environment: a page's ``cosim`` must be ``.venv/bin/cosim``, as a fresh clone has it.
+environment and any other ``cosim``: a page's ``cosim`` must be ``.venv/bin/cosim``, as a
+fresh clone has it.
 """
 
 from __future__ import annotations
@@ -100,10 +101,19 @@ class Clone:
         return self.root / ".venv" / "bin" / "python"
 
     def env(self) -> dict[str, str]:
-        """The reader's environment: no virtual environment active, none on ``PATH``."""
+        """The reader's environment: no virtual environment active, no ``cosim`` on ``PATH``.
+
+        A folder of ``PATH`` that holds a ``cosim`` (this environment's, another
+        installation's, a pyenv shim) is left out: a page's bare ``cosim`` would run a cosim
+        other than the clone's, and fails instead.
+        """
         env = {k: v for k, v in os.environ.items() if k not in ("VIRTUAL_ENV", "PYTHONPATH")}
         venvs = {str(Path(sys.prefix) / "bin"), str(Path(sys.executable).parent)}
-        path = [p for p in env.get("PATH", "").split(os.pathsep) if p and p not in venvs]
+        path = [
+            p
+            for p in env.get("PATH", "").split(os.pathsep)
+            if p and p not in venvs and not (Path(p) / "cosim").exists()
+        ]
         env["PATH"] = os.pathsep.join(path)
         return env
 
