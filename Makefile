@@ -5,6 +5,7 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 SCENARIO ?= warehouse-random
 OUT    ?= runs/demo
+ARGS   ?=
 
 STUDIES := runs/studies
 STUDY = $(BIN)/cosim study studies/$(1).toml --out $(STUDIES)/$(1) --resume
@@ -29,8 +30,9 @@ $(STAMP): pyproject.toml
 # to each module), so that the first `make demo` shows the real speed
 setup: $(STAMP)  ## create .venv, install cosim with its dev tools, compile the numba kernels
 
+# ARGS: more arguments of the run of demo, lab-real and lab-mixed (ARGS='--seed 3 --duration-s 30')
 demo: setup  ## run the default scenario and say where the results are
-	$(BIN)/cosim run $(SCENARIO) --out $(OUT) --force
+	$(BIN)/cosim run $(SCENARIO) --out $(OUT) --force $(ARGS)
 
 test: setup docs  ## the documentation build and the whole test suite, on every core (CI runs this)
 	$(BIN)/python -m pytest -q -n auto
@@ -63,10 +65,10 @@ reproduce: setup  ## Scenarios 1-3, reduced comm sweep, map sharing and people (
 	@echo "mixed reality: runs/lab-real-in-virtual/figures runs/lab-mixed/figures"
 
 lab-real: setup  ## Scenario 2: a stand-in physical robot through goals among virtual obstacles (1 min, real time)
-	$(BIN)/cosim run lab-real-in-virtual --standin --figures --force --out runs/lab-real-in-virtual
+	$(BIN)/cosim run lab-real-in-virtual --standin --figures --force --out runs/lab-real-in-virtual $(ARGS)
 
 lab-mixed: setup  ## Scenario 3: a stand-in physical robot and 3 virtual ones share tasks (1 min, real time)
-	$(BIN)/cosim run lab-mixed --standin --figures --force --out runs/lab-mixed
+	$(BIN)/cosim run lab-mixed --standin --figures --force --out runs/lab-mixed $(ARGS)
 
 study-comm: setup  ## the full comm sweep: 1,080 runs (about 30 min on 2 cores)
 	$(call STUDY,comm_sweep)

@@ -290,7 +290,10 @@ def build_parser() -> argparse.ArgumentParser:
     check.add_argument(
         "--print",
         action="store_true",
-        help="print the fully resolved scenario (without [provenance]: nothing ran)",
+        help=(
+            "print the fully resolved scenario (without [provenance]: nothing ran) alone on "
+            "stdout, the ok line and notes on stderr: `> mine.toml` writes a scenario file"
+        ),
     )
 
     world = commands.add_parser(

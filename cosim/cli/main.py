@@ -308,9 +308,12 @@ def _cmd_check(args: argparse.Namespace) -> int:
         assembly = assemble(scenario, recording=recording)
     if recording:
         RecordingSession.topics_of(scenario, assembly.run.bus)
-    print(f"ok: {_describe(scenario)}")
     if args.print:
+        # the TOML alone on stdout, so that `cosim check S --print > mine.toml` is a scenario file
+        print(f"ok: {_describe(scenario)}", file=sys.stderr)
         print(dump_scenario(scenario), end="")
+    else:
+        print(f"ok: {_describe(scenario)}")
     return EXIT_OK
 
 

@@ -1,18 +1,23 @@
 """Who held which task when, from the task's life: claimed, released or given way, served.
 
 The tasks table names only the robot that served a task (``robot``) and when a robot first
-claimed it (``t_assigned_s``); a claim given up in between is an event (``release``: the
-robot gave the task up, e.g. stuck; ``conflict``: it gave way to a better claim), each
-naming the task (``task N: ...``). A claim shows in the navigation table as a goal sent to
-the task's station. From these, each task's holdings: the robots that released it, in
-order, each from its claim to its release, then the robot that served it (or, if none did,
-the robot sent to its station right after the last release or the first claim) up to the
-completion, or to the end of the run if the task was still open.
+claimed it (``t_assigned_s``); a claim given up in between is an event whose source is the
+robot (``release``: the robot gave the task up, e.g. stuck; ``conflict``: it gave way to a
+better claim), each naming the task (``task N: ...``). The task source writes ``conflict``
+events too (source ``task_source``, ``task N: robot_3 replaced`` or ``... rejected``): how
+it settled a claim on a task another robot held, which no robot gave up by itself; a
+robot that lost gives way when it hears the better claim, in a ``conflict`` of its own. A
+claim shows in the navigation table as a goal sent to the task's station. From these, each
+task's holdings: the robots that released it, in order, each from its claim to its
+release, then the robot that served it (or, if none did, the robot sent to its station
+right after the last release or the first claim) up to the completion, or to the end of
+the run if the task was still open.
 """
 
 from __future__ import annotations
 
 import re
+from collections.abc import Collection
 
 import numpy as np
 import pandas as pd
@@ -24,12 +29,16 @@ CLAIM_WINDOW_S = 5.0
 the claim or release time (s): later goals to a shared station serve other tasks."""
 HOLD_COLUMNS = ("task", "robot", "t_from_s", "t_to_s", "end")
 GIVE_UP_KINDS = ("release", "conflict")
-"""Event kinds by which a robot gives its task up (the event's source is the robot)."""
+"""Event kinds by which a robot gives its task up, when the event's source is that robot."""
 _TASK_ID = re.compile(r"task (\d+)")
 
 
 def task_holds(
-    tasks: pd.DataFrame, navigation: pd.DataFrame | None, events: pd.DataFrame | None
+    tasks: pd.DataFrame,
+    navigation: pd.DataFrame | None,
+    events: pd.DataFrame | None,
+    *,
+    robots: Collection[str],
 ) -> pd.DataFrame:
     """Every holding of a task by a robot (columns :data:`HOLD_COLUMNS`).
 
@@ -40,6 +49,7 @@ def task_holds(
         navigation: the navigation table (``t_s``, ``robot``, ``event``, ``goal_x_m``,
             ``goal_y_m``), or None.
         events: the events table (``t_s``, ``source``, ``kind``, ``detail``), or None.
+        robots: the fleet's names: only their own events give a task up.
 
     Returns:
         A row per holding: ``task``; ``robot``; ``t_from_s`` (claim, s); ``t_to_s``
@@ -47,7 +57,7 @@ def task_holds(
         (``released``, ``completed`` or ``open``). A task never claimed has no row.
     """
     goals = _goals(navigation)
-    gives = _give_ups(events)
+    gives = _give_ups(events, robots)
     rows: list[tuple[float, str, float, float, str]] = []
     for task in tasks.to_dict("records"):
         k = float(task["task"])
@@ -94,12 +104,15 @@ def _goals(navigation: pd.DataFrame | None) -> pd.DataFrame:
     return navigation[navigation["event"] == "goal"]
 
 
-def _give_ups(events: pd.DataFrame | None) -> dict[int, list[tuple[float, str]]]:
-    """Per task id: (time s, robot) of each release or give-way, in time order."""
+def _give_ups(
+    events: pd.DataFrame | None, robots: Collection[str]
+) -> dict[int, list[tuple[float, str]]]:
+    """Per task id: (time s, robot) of each release or give-way by a robot, in time order."""
     out: dict[int, list[tuple[float, str]]] = {}
     if events is None:
         return out
-    given = events[events["kind"].isin(GIVE_UP_KINDS)].sort_values("t_s", kind="stable")
+    by_robot = events["source"].astype(str).isin(list(robots))
+    given = events[by_robot & events["kind"].isin(GIVE_UP_KINDS)].sort_values("t_s", kind="stable")
     for t_s, source, detail in zip(given["t_s"], given["source"], given["detail"], strict=True):
         match = _TASK_ID.match(str(detail))
         if match:

@@ -164,12 +164,13 @@ def load_run(run_dir: Path) -> RunData:
     tasks = _optional(run_dir, "tasks", TASK_COLUMNS)
     navigation = _optional(run_dir, "navigation", NAVIGATION_COLUMNS)
     events = _optional(run_dir, "events", EVENT_COLUMNS)
-    holds = None if tasks is None else task_holds(tasks, navigation, events)
+    track = _track(poses, poses_path)
+    holds = None if tasks is None else task_holds(tasks, navigation, events, robots=track.robots)
     return RunData(
         path=run_dir,
         scenario=scenario,
         warehouse=scenario_warehouse(scenario),
-        track=_track(poses, poses_path),
+        track=track,
         tasks=_with_holder(tasks, holds),
         messages=_optional(run_dir, "messages", MESSAGE_COLUMNS),
         assignments=_optional(run_dir, "assignments", ASSIGNMENT_COLUMNS),

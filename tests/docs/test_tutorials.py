@@ -1,10 +1,11 @@
-"""The tutorials' code, taken from the pages themselves, installed and run as a reader would.
+"""The tutorials run as their readers run them, and do what they say.
 
-Every code block with a ``title="path"`` is a file of the tutorial's package; the package is
-installed into a folder of its own (``pip install --target``) and used through cosim's
-command line, so a tutorial that stops working fails here, not for its reader. The plugin
-tutorials end with tests written with cosim's testing kit (``tests/test_*.py`` blocks): they
-run here with pytest, and ``cosim check-plugin`` on the plugin.
+Each tutorial's blocks run as ``test_pages.py`` runs the guides' (``tests/docs/pages.py``):
+the plugin tutorials' packages are written from the pages' titled blocks, installed with the
+page's own ``pip install -e``, run, checked with ``cosim check-plugin`` and tested with their
+kit-written tests, all in a clone of the repository; a command that fails fails here. Then,
+in the same clone, what each page promises of its outcome (a subtest each): the settings
+taken, the summary metrics and tables, the bag's types, the study's rows.
 """
 
 from __future__ import annotations
@@ -14,157 +15,118 @@ import os
 import re
 import subprocess
 import sys
-from pathlib import Path
+from collections.abc import Callable
 
 import pandas as pd
 import pytest
 
 from tests.conftest import REPO
+from tests.docs.blocks import Kind
+from tests.docs.pages import PAGES, PageRun, PageRuns, Part, parts, run_part
 
-pytestmark = pytest.mark.slow
-
-TUTORIALS = REPO / "docs" / "tutorials"
-BLOCK = re.compile(r'^```(\w+)(?: title="([^"]+)")?\n(.*?)^```$', re.M | re.S)
-
-
-def blocks(page: str) -> list[tuple[str, str | None, str]]:
-    """(language, title or None, code) of every fenced block of a tutorial page."""
-    text = (TUTORIALS / page).read_text()
-    return [(m.group(1), m.group(2), m.group(3)) for m in BLOCK.finditer(text)]
+TUTORIALS = tuple(page for page in PAGES if page.startswith("tutorials/"))
 
 
-def write_files(page: str, folder: Path) -> Path:
-    """The page's titled blocks as files under ``folder``."""
-    for _, title, code in blocks(page):
-        if title is not None:
-            path = folder / title
-            path.parent.mkdir(parents=True, exist_ok=True)
-            path.write_text(code)
-    return folder
+def _summary(page: PageRun, out: str) -> dict[str, object]:
+    summary: dict[str, object] = json.loads((page.clone.root / out / "summary.json").read_text())
+    return summary
 
 
-def install(page: str, tmp_path: Path) -> tuple[Path, dict[str, str]]:
-    """Build the page's package, install it into a folder; the environment that sees it."""
-    source = write_files(page, tmp_path / "src")
-    site = tmp_path / "site"
-    subprocess.run(
-        [sys.executable, "-m", "pip", "install", "--quiet", "--no-deps", "--no-build-isolation",
-         "--target", str(site), str(source)],
-        check=True, capture_output=True, timeout=300,
-    )  # fmt: skip
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(site), str(REPO)])}
-    return source, env
+def _plugin_passed(page: PageRun, name: str, tests: int) -> None:
+    """The page's ``cosim check-plugin NAME`` passed and its ``pytest`` ran ``tests`` tests."""
+    checked = page.output_of(f".venv/bin/cosim check-plugin {name}")
+    assert checked.stdout.splitlines()[-1].startswith(f"{name}: "), checked.told()
+    ran = page.output_of(".venv/bin/python -m pytest")
+    assert f"{tests} passed" in ran.stdout, ran.told()
 
 
-def cosim(
-    env: dict[str, str], *args: str, cwd: Path | None = None
-) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "cosim", *args], capture_output=True, text=True, env=env, cwd=cwd,
-        timeout=600,
-    )  # fmt: skip
-
-
-def check_and_test(env: dict[str, str], source: Path, name: str, tests: int) -> None:
-    """The page's plugin passes `cosim check-plugin`, and its kit-written tests pass.
-
-    The tests run as the reader runs them, with pytest; cosim's pytest plugin is asked for
-    by name (the shared environment's metadata predates its pytest11 entry point).
-    """
-    checked = cosim(env, "check-plugin", name)
-    assert checked.returncode == 0, checked.stdout + checked.stderr
-    assert checked.stdout.splitlines()[-1].startswith(f"{name}: ")
-    ran = subprocess.run(
-        [sys.executable, "-m", "pytest", "-q", "-p", "cosim.testing.plugin",
-         "-p", "no:cacheprovider", str(source / "tests")],
-        capture_output=True, text=True, env=env, cwd=source, timeout=600,
-    )  # fmt: skip
-    assert ran.returncode == 0, ran.stdout + ran.stderr
-    assert f"{tests} passed" in ran.stdout
-
-
-def test_the_adapter_tutorials_battery_installs_runs_and_takes_its_settings(tmp_path):
-    source, env = install("write-an-adapter.md", tmp_path)
-    listed = cosim(env, "plugins", "adapter", "section")
+def battery_takes_its_settings_and_records_its_table(page: PageRun) -> None:
+    listed = page.output_of(".venv/bin/cosim plugins adapter section")
     assert re.search(r"^  battery\s+fleet-battery\s", listed.stdout, re.M), listed.stdout
-    out = tmp_path / "run"
-    done = cosim(env, "run", "warehouse-random", "--set", 'scenario.adapters=["battery"]',
-                 "--set", "battery.idle_w=35", "--duration-s", "30", "--out", str(out))  # fmt: skip
-    assert done.returncode == 0, done.stderr
-    summary = json.loads((out / "summary.json").read_text())
-    assert 0.9 < summary["battery_lowest"] < 1.0
-    battery = pd.read_parquet(out / "tables" / "battery.parquet")
+    summary = _summary(page, "runs/battery")
+    assert 0.9 < float(str(summary["battery_lowest"])) < 1.0
+    battery = pd.read_parquet(page.clone.root / "runs" / "battery" / "tables" / "battery.parquet")
     assert list(battery.columns) == ["t_s", "robot", "charge_wh", "percentage"]
-    assert "[battery]\ncapacity_wh = 270.0" in (out / "scenario.toml").read_text()
-    info = cosim(env, "bag", "info", str(out / "bag"))
-    assert "sensor_msgs/msg/BatteryState" in info.stdout
-    refused = cosim(env, "check", "warehouse-random", "--set", "battery.idle_w=-1")
-    assert refused.returncode == 2 and "[battery] idle_w = -1" in refused.stderr
-    # from Python, with the package's source on the path but not installed: defaults
-    (snippet,) = [code for lang, title, code in blocks("write-an-adapter.md")
-                  if lang == "python" and title is None]  # fmt: skip
+    resolved = (page.clone.root / "runs" / "battery" / "scenario.toml").read_text()
+    assert "[battery]\ncapacity_wh = 270.0" in resolved and "idle_w = 35.0" in resolved
+    info = page.clone.shell(".venv/bin/cosim bag info runs/battery/bag")
+    assert "sensor_msgs/msg/BatteryState" in info.stdout, info.told()
+    _plugin_passed(page, "battery", tests=3)
+
+
+def battery_given_in_code_without_its_package_reads_its_defaults(page: PageRun) -> None:
+    (snippet,) = [b.code for b in page.blocks if b.kind is Kind.PYTHON]
     code = snippet + "\nprint(result.summary['battery_lowest'])\n"
-    plain = {**os.environ, "PYTHONPATH": os.pathsep.join([str(source), str(REPO)])}
-    ran = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         env=plain, timeout=300)  # fmt: skip
+    # this test environment has no fleet-battery installed: only its source on the path
+    source = page.clone.root / "fleet-battery"
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(source), str(REPO)])}
+    ran = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=300
+    )
     assert ran.returncode == 0, ran.stderr
     assert 0.0 < float(ran.stdout.split()[-1]) < 1.0
-    check_and_test(env, source, "battery", tests=3)
 
 
-def test_the_protocol_tutorials_cheapest_pairs_runs_alone_and_in_its_study(tmp_path):
-    source, env = install("write-a-protocol.md", tmp_path)
-    out = tmp_path / "run"
-    done = cosim(env, "run", "warehouse-random", "--set", "robots.driver=tasks",
-                 "--set", "assignment.protocol=cheapest_pairs",
-                 "--set", "cheapest_pairs.quiet_rounds=2", "--duration-s", "60",
-                 "--out", str(out))  # fmt: skip
-    assert done.returncode == 0, done.stderr
-    summary = json.loads((out / "summary.json").read_text())
-    assert summary["tasks_completed"] >= 3
-    assert summary["optimality_gap"] is not None and summary["optimality_gap"] >= 0.0
-    typo = cosim(env, "check", "warehouse-random", "--set", "assignment.protocol=cheapest_pair")
-    assert typo.returncode == 2 and "did you mean 'cheapest_pairs'?" in typo.stderr
-    study = cosim(env, "study", str(source / "pairs_study.toml"), "--out", str(tmp_path / "s"),
-                  "--workers", "2")  # fmt: skip
-    assert study.returncode == 0, study.stderr
-    rows = pd.read_parquet(tmp_path / "s" / "results.parquet")
+def cheapest_pairs_serves_tasks_alone_and_in_its_study(page: PageRun) -> None:
+    summary = _summary(page, "runs/pairs")
+    assert int(str(summary["tasks_completed"])) >= 3
+    gap = summary["optimality_gap"]
+    assert gap is not None and float(str(gap)) >= 0.0
+    rows = pd.read_parquet(page.clone.root / "runs" / "pairs_study" / "results.parquet")
     assert len(rows) == 8 and set(rows["status"]) == {"ok"}
-    check_and_test(env, source, "cheapest_pairs", tests=3)
+    _plugin_passed(page, "cheapest_pairs", tests=3)
 
 
-def test_the_controller_tutorials_turn_then_go_drives_robots_to_their_goals(tmp_path):
-    source, env = install("write-a-controller.md", tmp_path)
-    out = tmp_path / "run"
-    done = cosim(env, "run", "warehouse-random", "--set", "navigation.controller=turn_then_go",
-                 "--set", "turn_then_go.heading_gain=3", "--duration-s", "60",
-                 "--out", str(out))  # fmt: skip
-    assert done.returncode == 0, done.stderr
-    summary = json.loads((out / "summary.json").read_text())
-    assert summary["arrivals"] >= 4
+def turn_then_go_drives_robots_to_their_goals_within_limits(page: PageRun) -> None:
+    summary = _summary(page, "runs/ttg")
+    assert int(str(summary["arrivals"])) >= 4
     assert summary["controller_commands_clipped"] == 0  # it keeps to the limits, as the page says
-    refused = cosim(env, "check", "warehouse-random", "--set", "turn_then_go.stop_m=0")
-    assert refused.returncode == 2 and "expected a number > 0" in refused.stderr
-    check_and_test(env, source, "turn_then_go", tests=3)
+    _plugin_passed(page, "turn_then_go", tests=3)
 
 
-def test_the_study_tutorial_runs_and_its_analysis_reads_the_results(tmp_path):
-    write_files("run-a-study.md", tmp_path)
-    env = {**os.environ, "PYTHONPATH": str(REPO)}
-    done = cosim(env, "study", "loss_study.toml", "--out", "runs/loss", "--workers", "2",
-                 cwd=tmp_path)  # fmt: skip
-    assert done.returncode == 0, done.stderr
-    assert (tmp_path / "runs" / "loss" / "report.md").is_file()
-    (analysis,) = [code for lang, title, code in blocks("run-a-study.md")
-                   if lang == "python" and title is None]  # fmt: skip
-    ran = subprocess.run([sys.executable, "-c", analysis], capture_output=True, text=True,
-                         cwd=tmp_path, env=env, timeout=300)  # fmt: skip
-    assert ran.returncode == 0, ran.stderr
-    assert "tasks_per_min_ci_low" in ran.stdout
+def the_study_writes_its_report_and_its_analysis_prints_intervals(page: PageRun) -> None:
+    assert (page.clone.root / "runs" / "loss" / "report.md").is_file()
+    rows = pd.read_parquet(page.clone.root / "runs" / "loss" / "results.parquet")
+    assert len(rows) == 18 and set(rows["status"]) == {"ok"}
+    analysis = page.python_ran()[-1]
+    assert "tasks_per_min_ci_low" in analysis.stdout, analysis.told()
 
 
-def test_the_physical_robot_tutorials_scenario_checks_without_touching_the_network(tmp_path):
-    write_files("physical-robot.md", tmp_path)
-    env = {**os.environ, "PYTHONPATH": str(REPO)}
-    done = cosim(env, "check", "lab-with-my-robot.toml", cwd=tmp_path)
-    assert done.returncode == 0, done.stderr
+def the_stand_in_runs_leave_their_figures_and_their_domain(page: PageRun) -> None:
+    for run in ("lab-real-in-virtual", "lab-mixed"):
+        figures = page.clone.root / "runs" / run / "figures"
+        assert (figures / "trajectories.png").is_file(), run
+        assert _summary(page, f"runs/{run}")["physical_dds_domain"] is not None
+
+
+PROMISES: dict[str, tuple[Callable[[PageRun], None], ...]] = {
+    "tutorials/write-an-adapter.md": (
+        battery_takes_its_settings_and_records_its_table,
+        battery_given_in_code_without_its_package_reads_its_defaults,
+    ),
+    "tutorials/write-a-protocol.md": (cheapest_pairs_serves_tasks_alone_and_in_its_study,),
+    "tutorials/write-a-controller.md": (turn_then_go_drives_robots_to_their_goals_within_limits,),
+    "tutorials/run-a-study.md": (the_study_writes_its_report_and_its_analysis_prints_intervals,),
+    "tutorials/physical-robot.md": (the_stand_in_runs_leave_their_figures_and_their_domain,),
+}
+"""What each tutorial's slow part must show once its blocks ran."""
+
+
+@pytest.mark.parametrize(
+    "part",
+    [
+        pytest.param(part, id=part.name, marks=[pytest.mark.slow] if part.slow else [])
+        for part in parts(TUTORIALS)
+    ],
+)
+def test_a_tutorial_runs_as_its_reader_would_run_it_and_does_what_it_says(
+    part: Part, page_runs: PageRuns, subtests: pytest.Subtests
+):
+    page = run_part(part, page_runs, subtests)
+    for promise in PROMISES[part.page] if part.slow else ():
+        with subtests.test(msg=f"{part.page}: {promise.__name__.replace('_', ' ')}"):
+            promise(page)
+
+
+def test_every_tutorial_has_its_promises_checked():
+    assert set(PROMISES) == set(TUTORIALS)

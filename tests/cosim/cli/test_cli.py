@@ -207,6 +207,20 @@ def test_check_can_print_the_resolved_scenario(capsys):
     assert "[lidar]\nbeams = 360" in capsys.readouterr().out
 
 
+def test_check_print_writes_the_scenario_alone_to_stdout_and_the_printed_file_runs(tmp_path):
+    printed = cosim_main("check", "warehouse-random", "--print")
+    assert printed.returncode == 0, printed.stderr
+    assert printed.stderr.startswith("ok: warehouse-random (preset warehouse-random)")
+    assert "ok:" not in printed.stdout
+    (tmp_path / "my-hall.toml").write_text(printed.stdout)  # `... --print > my-hall.toml`
+    ran = cosim_main(
+        "run", "my-hall.toml", "--out", "runs/mine", "--duration-s", "2", "--bag", "none",
+        cwd=tmp_path,
+    )  # fmt: skip
+    assert ran.returncode == 0, ran.stderr
+    assert json.loads((tmp_path / "runs" / "mine" / "summary.json").read_text())["robots"] == 4
+
+
 def test_scenarios_lists_every_preset_on_one_line_each(capsys):
     assert main(["scenarios"]) == 0
     lines = capsys.readouterr().out.splitlines()

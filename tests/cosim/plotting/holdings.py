@@ -12,6 +12,8 @@ import pandas as pd
 
 STATION = (2.0, 3.0)
 """Task 0's station (m, ``map``)."""
+FLEET = tuple(f"robot_{i}" for i in range(1, 10))
+"""The robots whose events may give a task up (robot_1 to robot_9)."""
 
 
 def tasks_table() -> pd.DataFrame:

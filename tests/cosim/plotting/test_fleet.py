@@ -23,7 +23,13 @@ from cosim.plotting.fleet import (
 from cosim.plotting.ownership import task_holds
 from cosim.plotting.rundata import RunData, load_run
 from tests.cosim.plotting.conftest import TASKS
-from tests.cosim.plotting.holdings import STATION, events_table, navigation_table, tasks_table
+from tests.cosim.plotting.holdings import (
+    FLEET,
+    STATION,
+    events_table,
+    navigation_table,
+    tasks_table,
+)
 
 
 def _synthetic(run: RunData) -> RunData:
@@ -31,7 +37,11 @@ def _synthetic(run: RunData) -> RunData:
     tasks, nav, events = tasks_table(), navigation_table(), events_table()
     track = dataclasses.replace(run.track, t_s=np.linspace(0.0, 30.0, len(run.track.t_s)))
     return dataclasses.replace(
-        run, track=track, tasks=tasks, holds=task_holds(tasks, nav, events), navigation=nav
+        run,
+        track=track,
+        tasks=tasks,
+        holds=task_holds(tasks, nav, events, robots=FLEET),
+        navigation=nav,
     )
 
 

@@ -16,7 +16,8 @@ from cosim.plotting.canvas import run_colors
 from cosim.plotting.ownership import task_holds
 from cosim.plotting.rundata import RunData, load_run
 from cosim.plotting.timeline import BAR_HEIGHT, UNHELD, timeline_figure
-from tests.cosim.plotting.holdings import events_table, navigation_table, tasks_table
+from tests.conftest import cosim_main
+from tests.cosim.plotting.holdings import FLEET, events_table, navigation_table, tasks_table
 
 END_S = 30.0
 
@@ -25,7 +26,7 @@ def _with_tasks(run: RunData, tasks: pd.DataFrame) -> RunData:
     """``run`` over 0-30 s with ``tasks``, held as the synthetic navigation and events say."""
     nav, events = navigation_table(), events_table()
     track = dataclasses.replace(run.track, t_s=np.linspace(0.0, END_S, len(run.track.t_s)))
-    holds = task_holds(tasks, nav, events)
+    holds = task_holds(tasks, nav, events, robots=FLEET)
     return dataclasses.replace(run, track=track, tasks=tasks, holds=holds, navigation=nav)
 
 
@@ -133,3 +134,24 @@ def test_a_run_without_tasks_has_no_timeline(waypoint_run: Path, tmp_path: Path)
 def test_the_timeline_of_a_task_run_is_written(task_run: Path, tmp_path: Path):
     path = timeline_figure(load_run(task_run), tmp_path / "tasks.png")
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.slow
+def test_a_run_whose_task_source_settled_conflicting_claims_draws_its_figures(tmp_path: Path):
+    # the getting-started run (6 robots in the rows hall on a degraded network), shortened:
+    # seed 19 gives, within 30 s, claims the task source rejected and one it let replace
+    # another; those rows name the task source, which is no robot and holds no task
+    out = tmp_path / "rows"
+    done = cosim_main(
+        "run", "warehouse-rows", "--out", str(out), "--seed", "19", "--duration-s", "30",
+        "--set", "robots.count=6", "--set", "network.profile=wifi_degraded", "--figures",
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    events = pd.read_parquet(out / "tables" / "events.parquet")
+    settled = events[(events["source"] == "task_source") & (events["kind"] == "conflict")]
+    assert {str(d).split()[-1] for d in settled["detail"]} == {"rejected", "replaced"}
+    assert (out / "figures" / "tasks.png").is_file()
+    run = load_run(out)
+    assert run.holds is not None and set(run.holds["robot"]) <= set(run.track.robots)
+    redrawn = cosim_main("plot", str(out))
+    assert redrawn.returncode == 0, redrawn.stderr
