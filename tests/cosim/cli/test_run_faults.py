@@ -186,13 +186,19 @@ def test_force_replaces_the_earlier_run_and_keeps_the_users_files(tmp_path):
 
 
 def _cosim_run(out: Path, *extra: str) -> subprocess.Popen[str]:
-    """``python -m cosim run`` of a long run into ``out``, with Ctrl-C at its default."""
+    """``python -m cosim run`` of a long run into ``out``, with Ctrl-C and SIGHUP at their
+    defaults, as from a terminal (the tests may run under ``nohup``, which ignores SIGHUP)."""
     return subprocess.Popen(
         [sys.executable, "-m", "cosim", "run", "warehouse-random", "--duration-s", "1e6",
          "--out", str(out), *SMALL, *extra],
         cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+        preexec_fn=_terminal_signals,
     )  # fmt: skip
+
+
+def _terminal_signals() -> None:
+    for sig in (signal.SIGINT, signal.SIGHUP):
+        signal.signal(sig, signal.SIG_DFL)
 
 
 def _wait_until_running(process: subprocess.Popen[str], bag: Path) -> None:

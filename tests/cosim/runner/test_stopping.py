@@ -82,7 +82,15 @@ def test_a_signal_while_deferring_is_noted_and_a_second_one_stops_at_once():
             request.handle(signal.SIGHUP)
 
 
-def test_sigterm_and_sighup_reach_the_request_and_the_handlers_are_restored():
+@pytest.fixture
+def sighup_at_its_default():
+    """SIGHUP as a terminal leaves it (the tests may run under ``nohup``, which ignores it)."""
+    previous = signal.signal(signal.SIGHUP, signal.SIG_DFL)
+    yield
+    signal.signal(signal.SIGHUP, previous)
+
+
+def test_sigterm_and_sighup_reach_the_request_and_the_handlers_are_restored(sighup_at_its_default):
     before = {sig: signal.getsignal(sig) for sig in (signal.SIGTERM, signal.SIGHUP)}
     with stop_on_signals() as request, request.deferred():
         signal.raise_signal(signal.SIGTERM)
