@@ -22,6 +22,8 @@ from typing import Any
 from cosim.core.errors import RegistryError
 
 COSIM = "cosim"
+GROUPS = "cosim."
+"""The entry-point groups cosim reads begin so (``cosim.protocols``, ``cosim.registries``)."""
 """cosim's own distribution: its entries are built-ins (listed first), its faults cosim's bugs."""
 
 
@@ -38,6 +40,10 @@ class Lazy:
     """
 
     point: Any
+    known_package: str | None = None
+    """The distribution's name, when read once for all its entry points."""
+    known_version: str | None = None
+    """Its version, likewise."""
 
     def load(self) -> Any:
         """Import the entry point's object."""
@@ -61,12 +67,16 @@ class Lazy:
     @property
     def package(self) -> str:
         """The distribution that declares the entry point."""
+        if self.known_package is not None:
+            return self.known_package
         dist = getattr(self.point, "dist", None)
         return str(dist.name) if dist is not None else "?"
 
     @property
     def version(self) -> str:
         """The version of the distribution that declares it (``""`` when not known)."""
+        if self.known_version is not None:
+            return self.known_version
         dist = getattr(self.point, "dist", None)
         return str(dist.version) if dist is not None else ""
 
@@ -103,14 +113,22 @@ class Clash:
 
 @cache
 def installed() -> tuple[Lazy, ...]:
-    """Every entry point of every installed distribution, cosim's first, then by package."""
+    """Every entry point of a ``cosim.*`` group, cosim's first, then by package.
+
+    A distribution's metadata is read once for all its entry points (reading it per entry
+    point took about 0.1 s of every run).
+    """
     found, seen = [], set()
     for dist in distributions():
-        key = re.sub(r"[-_.]+", "-", str(dist.metadata["Name"])).lower()
+        points = [point for point in dist.entry_points if point.group.startswith(GROUPS)]
+        metadata = dist.metadata
+        name = str(metadata["Name"])
+        key = re.sub(r"[-_.]+", "-", name).lower()
         if key in seen:  # the same distribution twice on the path: the first is imported
             continue
         seen.add(key)
-        found += [Lazy(point) for point in dist.entry_points]
+        version = str(metadata["Version"] or "")
+        found += [Lazy(point, name, version) for point in points]
     ours = [p for p in found if p.package == COSIM]
     theirs = sorted((p for p in found if p.package != COSIM), key=lambda p: p.package.lower())
     return (*ours, *theirs)
