@@ -100,7 +100,9 @@ def test_a_map_folder_of_format_0_is_known_by_its_summary(tmp_path):
 
 
 def test_a_run_folder_names_its_bag_and_a_bag_names_itself(tmp_path):
-    folder = OLD_RUNS / "before-462a048"
+    folder = tmp_path / "before-462a048"  # kept without its bag: a folder stands for it
+    shutil.copytree(OLD_RUNS / "before-462a048", folder)
+    (folder / BAG_DIR).mkdir()
     assert bag_of(folder) == folder / BAG_DIR
     assert bag_of(folder / BAG_DIR) == folder / BAG_DIR
     assert bag_of(OLD_RUNS / "at-99e8d54") == OLD_RUNS / "at-99e8d54"  # no bag: the bag reader says
