@@ -10,7 +10,7 @@ ARGS   ?=
 STUDIES := runs/studies
 STUDY = $(BIN)/cosim study studies/$(1).toml --out $(STUDIES)/$(1) --resume
 
-.PHONY: setup demo test test-fast docs lint bench clean help reproduce study-comm study-comm-reduced \
+.PHONY: setup demo test test-fast docs lint bench bench-peers clean help reproduce study-comm study-comm-reduced \
 	study-burst study-scale study-paper study-nav study-mapping study-mapping-reduced \
 	study-mapping-acceptance study-mapping-drift map-aces map-fr079 \
 	lab-real lab-mixed study-humans study-humans-reduced study-humans-contacts study-traffic
@@ -51,6 +51,15 @@ lint: setup  ## ruff and mypy --strict
 
 bench: setup  ## benchmarks -> bench/results.json
 	$(BIN)/python bench/run.py --out bench/results.json
+
+PEERS := bench/peers/.venv
+$(PEERS)/.installed: bench/peers/requirements.txt
+	$(PYTHON) -m venv $(PEERS)
+	$(PEERS)/bin/python -m pip install --quiet -r bench/peers/requirements.txt
+	touch $@
+
+bench-peers: setup $(PEERS)/.installed  ## cosim beside IR-SIM-X (its own venv) on the 50-robot hall -> bench/results.json
+	$(BIN)/python bench/run.py --out bench/results.json --only peers
 
 reproduce: setup  ## Scenarios 1-3, reduced comm sweep, map sharing and people (about 8 min on 2 cores)
 	$(call STUDY,paper)

@@ -138,7 +138,17 @@ def run_case(cosim: str, name: str, args: list[str], root: Path) -> dict[str, st
     for part in sorted((out / "bag").iterdir()):
         found[f"bag/{part.name}"] = file_hash(part)
     summary = json.loads((out / "summary.json").read_text())
-    volatile = ("wall", "real_time", "version", "started", "compile", "host", "worker", "path")
+    volatile = (
+        "wall",
+        "real_time",
+        "version",
+        "started",
+        "compile",
+        "host",
+        "worker",
+        "path",
+        "thread",
+    )
     kept = {k: v for k, v in summary.items() if not any(w in k for w in volatile)}
     for key, value in sorted(kept.items()):  # by key, so a difference names its entry
         found[f"summary/{key}"] = hashlib.sha256(json.dumps(value).encode()).hexdigest()[:16]

@@ -15,6 +15,7 @@ from landmarks_bench import landmark_savings
 from lidar_bench import lidar_rays_per_second
 from mapping_bench import fleet50_mapping, per_scan_costs, recordings_mapping
 from network_bench import network_deliveries_per_second
+from peers_bench import irsim_peer
 from planner_bench import planner_ms
 from recording_bench import bag_cost, bag_memory_1h, encoding
 from scale_bench import fleet_scaling
@@ -434,4 +435,9 @@ SUITES: dict[str, Callable[[int], Result]] = {
     "recordings_mapping": recordings_mapping,
     "humans_coupling": humans_coupling,
     "cli_startup": cli_startup,
+    "peers": irsim_peer,
 }
+
+ON_REQUEST = {"peers"}
+"""Suites ``make bench`` leaves out: ``peers`` needs the peer's own environment, which
+``make bench-peers`` installs before running it."""

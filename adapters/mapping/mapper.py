@@ -27,6 +27,7 @@ from adapters.fleet.topics import odom_topic
 from adapters.mapping.contract import MAP_SHARING, MapSharing, SharingContext
 from adapters.mapping.geometry import map_geometry
 from adapters.mapping.memory import check_mapping_memory
+from adapters.mapping.pending import Pending, ThreadScratch
 from adapters.mapping.settings import MappingConfig
 from adapters.mapping.tables import (
     MAP_MERGES,
@@ -38,6 +39,7 @@ from adapters.mapping.tables import (
 from adapters.mapping.topics import FLEET_MAP, correction_topic, map_topic
 from adapters.sensing.topics import scan_topic
 from cosim.core.adapter import RunContext
+from cosim.core.batches import InstantBatch
 from cosim.core.bus import Envelope, TopicQos
 from cosim.core.hosts import BASE_HOST, HostId
 from cosim.core.kernel import Stage
@@ -60,7 +62,7 @@ from models.geometry.occupancy import OccupancyGrid as Grid
 from models.mapping.grid import LogOddsMap, Scratch, merged
 from models.mapping.loop_params import LoopParams
 from models.mapping.matcher import MatcherParams
-from models.mapping.slam import MapperParams, ScanMapper, UpdateGate
+from models.mapping.slam import MapperParams, ScanMapper, Update, UpdateGate
 from models.sensing.lidar import ScanGeometry
 from models.world.warehouse import Warehouse
 
@@ -141,6 +143,7 @@ class MappingAdapter:
         ).angles()
         self.geometry = map_geometry(world, self.cfg.resolution_m)
         scratch = Scratch(self.geometry)
+        self._scratches = ThreadScratch(self.geometry)
         sharing = MAP_SHARING.installed().get(self.cfg.share)
         track = sharing.tracks_changes
         self.maps = [
@@ -176,6 +179,13 @@ class MappingAdapter:
         # left out of its map and its matching (robots are not the building); whether one
         # runs is known once every adapter is built (the navigation provides it)
         self.robots_layer: RobotsLayer | None = None
+        self._batch: InstantBatch[Pending, Update | None] = InstantBatch(
+            run.kernel,
+            run.workers,
+            self._process,
+            lambda item, update: self._mapped(run, item, update),
+            Stage.SENSING,
+        )
 
     # -- wiring ----------------------------------------------------------------------
     def start(self, run: RunContext) -> None:
@@ -229,35 +239,54 @@ class MappingAdapter:
 
     # -- a robot's own scans ---------------------------------------------------------------
     def _scan(self, run: RunContext, i: int, scan: LaserScan) -> None:
+        """Keep a scan that would update robot ``i``'s map, for this instant's batch."""
         now = run.kernel.now_ns
         odom = self.odom[i]
-        mapper = self.mappers[i]
-        if not mapper.due(now, odom):
+        if not self.mappers[i].due(now, odom):
             return
         ranges = scan.ranges_m
         if self.robots_layer is not None:
             ranges = self._without_robots(
                 self.robots_layer, i, now, ranges.astype(np.float64)
             ).astype(np.float32)
-        update = mapper.process(now, odom, ranges)
+        self._batch.add(Pending(i, now, odom, ranges, scan))
+
+    def _mapped(self, run: RunContext, item: Pending, update: Update | None) -> None:
+        """What a mapped scan sends: its record, the robot's correction, shared evidence."""
         if update is None:
             return
-        fleet = self.fleet
-        truth = (float(fleet.x[i]), float(fleet.y[i]))
+        now = run.kernel.now_ns
+        i, odom = item.robot, item.odom
+        truth = (float(self.fleet.x[i]), float(self.fleet.y[i]))
         self.records.update(
             now, i, update.pose, truth, (odom[0], odom[1]), update.score, update.matched
         )
         correction = self.mappers[i].correction
-        name = self.names[i]
-        tf = TFMessage(now, (Transform("map", f"{name}/odom", *correction),))
+        tf = TFMessage(now, (Transform("map", f"{self.names[i]}/odom", *correction),))
         run.bus.publish(self.tf_topics[i], tf, self.hosts[i])
-        self.sharing.mapped(run, i, update.pose, scan)
+        self.sharing.mapped(run, i, update.pose, item.scan)
+
+    def _process(self, item: Pending) -> Update | None:
+        """One robot's scan, on whichever thread runs it, with that thread's scratch.
+
+        Each robot's mapper reads and writes only its own map, so the scans of one instant
+        are matched and mapped at once (:class:`~cosim.core.batches.InstantBatch`).
+        """
+        grid = self.maps[item.robot]
+        shared = grid.scratch
+        grid.scratch = self._scratches.mine()
+        try:
+            return self.mappers[item.robot].process(item.now_ns, item.odom, item.ranges)
+        finally:
+            grid.scratch = shared
 
     # -- maps out --------------------------------------------------------------------------
     def _publish_maps(self, run: RunContext, now_ns: int) -> None:
         bus = run.bus
-        for grid, name, host in zip(self.maps, self.map_topics, self.hosts, strict=True):
-            bus.publish(name, grid_message(now_ns, grid), host)
+        # each robot's grid classified on the run's threads, published in robot order
+        messages = run.workers.map(lambda grid: grid_message(now_ns, grid), self.maps)
+        for message, name, host in zip(messages, self.map_topics, self.hosts, strict=True):
+            bus.publish(name, message, host)
         bus.publish(FLEET_MAP, occupancy_message(now_ns, merged(self.maps)), BASE_HOST)
 
     def _sample(self, now_ns: int) -> None:

@@ -24,6 +24,9 @@ class AStar:
     """A* with landmark bounds on the building's map, and windowed repairs."""
 
     name: ClassVar[str] = "astar"
+    concurrent: ClassVar[bool] = True
+    """Plans of different robots may run at once (each reads the shared maps and writes
+    only its own arrays; the landmark cache builds under a lock)."""
 
     def __init__(self, context: PlannerContext) -> None:
         self.static = context.static

@@ -30,6 +30,7 @@ from models.fleet.kinematics import DriveLimits
 from models.geometry.occupancy import OccupancyGrid
 from models.navigation.costmap import StaticCostmap
 from models.navigation.traffic import MovingPoints
+from models.slicing import Slices, whole
 from models.world.warehouse import Warehouse, ground_truth_grid
 
 Route = tuple[FloatArray, float]
@@ -72,6 +73,9 @@ class ControlInputs:
             at ``discs[disc_start[i]:disc_start[i + 1]]`` (empty without the robots layer).
         disc_start: (n + 1,) offsets into ``discs``.
         now_ns: simulated time (ns).
+        slices: cuts the robots over the run's threads (:mod:`models.slicing`); a batch
+            controller whose robots are independent may hand it to its kernel, each
+            robot's command the same whatever the cut.
     """
 
     pose: FloatArray
@@ -84,6 +88,7 @@ class ControlInputs:
     discs: FloatArray
     disc_start: IntArray
     now_ns: int
+    slices: Slices = whole
 
 
 class LocalController(Protocol):
@@ -203,6 +208,12 @@ class RepairRequest:
 
 class GlobalPlanner(Protocol):
     """What a ``cosim.planners`` entry point names: a class built once per run.
+
+    A planner may also say ``concurrent: ClassVar[bool] = True``: the plans of different
+    robots due at one instant may then run at once on the run's threads (``--threads``),
+    so :meth:`plan` and :meth:`repair` must not write state another call reads. Without
+    it, plans run one after another. Either way they are followed in robot order, so the
+    tables are the same.
 
     Attributes:
         name: the registered name (``navigation.planner``).

@@ -82,6 +82,17 @@ class StaticLayers:
 
     def update(self, robot: int, message: GridMessage) -> None:
         """A robot's new map: resample, make unknown traversable, inflate, restack."""
+        self.set(robot, self.build(robot, message))
+
+    def build(self, robot: int, message: GridMessage) -> StaticCostmap:
+        """The costmap of robot ``robot``'s new map, not used yet (see :meth:`set`).
+
+        Resampled, unknown cells traversable, inflated. It reads only the layers' settings,
+        so the maps of several robots may be built at once on different threads.
+
+        Raises:
+            ValueError: the map does not cover the same area as the robot's costmap.
+        """
         cells = np.frombuffer(message.data, dtype=np.int8).reshape(message.height, message.width)
         origin = (message.origin_x_m, message.origin_y_m)
         # with unknown cells traversable only the obstacles count: when the costmap's cells
@@ -99,6 +110,10 @@ class StaticLayers:
                 f"map of {message.width} x {message.height} cells does not cover the same "
                 f"area as robot {robot}'s costmap"
             )
+        return layer
+
+    def set(self, robot: int, layer: StaticCostmap) -> None:
+        """Robot ``robot`` plans on ``layer`` from now on (from :meth:`build`)."""
         self.layers[robot] = layer
         self.distance[robot] = layer.distance_m
         self.updates += 1

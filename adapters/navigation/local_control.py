@@ -42,5 +42,6 @@ class DwaControl:
             inputs.discs,
             inputs.disc_start,
             self.params,
+            inputs.slices,
         )
         return result.v, result.w, result.blocked

@@ -143,11 +143,21 @@ class GlobalPlanning:
         on_path = paths_blocked(
             self.paths, moving.owner, moving.points, self.radius + PATH_CLEARANCE_M
         )
+        replan = []
         for i in np.flatnonzero(due).tolist():
             if self.planned_around[i] or on_path[i]:
-                self.plan(run, i, now_ns, replan=True)
+                replan.append(i)
             else:
                 self.next_plan_ns[i] = now_ns + self.replan_ns
+        if len(replan) > 1 and getattr(self.planner, "concurrent", False):
+            # routes of different robots at once on the run's threads; followed in order
+            started = time.perf_counter()
+            routes = run.workers.map(lambda i: self.route(i, now_ns, replan=True), replan)
+            for i, found in zip(replan, routes, strict=True):
+                self.finish(run, i, now_ns, found, started, replan=True)
+            return
+        for i in replan:
+            self.plan(run, i, now_ns, replan=True)
 
     def _obstacles(self, i: int, now_ns: int) -> tuple[np.ndarray, np.ndarray]:
         """What robot ``i`` plans round: moving things it remembers, robots it hears."""

@@ -100,6 +100,7 @@ class NavigationAdapter:
         self.pose = self.parts.pose
         self.clipped = 0
         """Robot commands of the local controller clipped to the drive limits, so far."""
+        self.workers = run.workers
 
     # -- the bus ----------------------------------------------------------------------
     def start(self, run: RunContext) -> None:
@@ -222,7 +223,17 @@ class NavigationAdapter:
             discs, disc_start = parts.robots_layer.all_discs(now_ns)
         vel = parts.localization.vel
         inputs = ControlInputs(
-            self.pose, vel, carrots, goals, points, start, moving, discs, disc_start, now_ns
+            self.pose,
+            vel,
+            carrots,
+            goals,
+            points,
+            start,
+            moving,
+            discs,
+            disc_start,
+            now_ns,
+            self.workers.chunks,
         )
         returned = parts.control.commands(inputs)
         v, w, blocked, clipped = checked_commands(

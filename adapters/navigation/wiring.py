@@ -21,11 +21,14 @@ from adapters.navigation.scan_memory import ScanMemory
 from adapters.navigation.topics import goal_topic, plan_topic, status_topic
 from adapters.sensing.topics import scan_topic
 from cosim.core.adapter import RunContext
+from cosim.core.batches import InstantBatch
 from cosim.core.bus import Bus, Envelope
 from cosim.core.hosts import HostId
+from cosim.core.kernel import Stage
 from cosim.core.messages import LaserScan, Message, NavGoal, NavStatus, Path, Twist
 from cosim.core.messages import OccupancyGrid as GridMessage
 from models.arrays import FloatArray
+from models.navigation.costmap import StaticCostmap
 
 Handler = Callable[[Message, Envelope], None]
 """A bus subscriber's callback."""
@@ -88,14 +91,23 @@ class NavWiring:
                 when the scan arrived.
             pose: (n, 3) every robot's pose estimate in ``map`` (m, rad), read on arrival.
             layers: every robot's static layer (its own map when robots map).
-            mapping: robots build their own maps (their ``map`` topic updates ``layers``).
+            mapping: robots build their own maps (their ``map`` topic updates ``layers``:
+                the maps of one instant are inflated together on the run's threads, and
+                used from the end of the control stage they arrived in).
         """
         bus = run.bus
+        costmaps: InstantBatch[tuple[int, GridMessage], StaticCostmap] = InstantBatch(
+            run.kernel,
+            run.workers,
+            lambda item: layers.build(*item),
+            lambda item, layer: layers.set(item[0], layer),
+            Stage.CONTROL,
+        )
         for i, (name, host) in enumerate(zip(self.names, self.hosts, strict=True)):
             bus.subscribe(goal_topic(name), host, _on_goal(run, goals, i))
             bus.subscribe(scan_topic(name), host, _on_scan(memory, pose, i))
             if mapping:
-                bus.subscribe(map_topic(name), host, _on_map(layers, i))
+                bus.subscribe(map_topic(name), host, _on_map(costmaps, i))
 
     def publish_commands(self, run: RunContext, v: FloatArray, w: FloatArray) -> None:
         """Every robot's command: speed ``v`` (m/s) and yaw rate ``w`` (rad/s), ``base_link``."""
@@ -119,9 +131,9 @@ def _on_scan(memory: ScanMemory, pose: FloatArray, i: int) -> Handler:
     return on_scan
 
 
-def _on_map(layers: StaticLayers, i: int) -> Handler:
+def _on_map(costmaps: InstantBatch[tuple[int, GridMessage], StaticCostmap], i: int) -> Handler:
     def on_map(message: Message, _envelope: Envelope) -> None:
         assert isinstance(message, GridMessage)
-        layers.update(i, message)
+        costmaps.add((i, message))
 
     return on_map

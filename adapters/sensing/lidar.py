@@ -99,6 +99,7 @@ class LidarAdapter:
             circles,
             self._own,
             geometry.range_max_m,
+            slices=run.workers.chunks,
         )
         scan_time_s = self.period_ns / 1e9
         # a disabled error source draws nothing (its stream is simply not used)

@@ -7,7 +7,6 @@ A flag's value is checked as it is parsed; a bad one is one line and exit status
 from __future__ import annotations
 
 import argparse
-import math
 from pathlib import Path
 from typing import NoReturn
 
@@ -15,6 +14,20 @@ from adapters.physical.standin_options import add_arguments as add_standin_argum
 from cosim.cli.checkplugin import add_arguments as add_check_plugin_arguments
 from cosim.cli.exits import EXIT_INPUT
 from cosim.cli.hostname import host_argument
+from cosim.cli.values import (
+    cell_size_m,
+    duration_s,
+    folder,
+    non_negative_float,
+    non_negative_int,
+    port,
+    positive_float,
+    positive_int,
+    registry_kind,
+    score,
+    threads,
+    times,
+)
 from cosim.scenario.fields import key_bounds
 from cosim.scenario.sections import ScenarioSection
 
@@ -32,126 +45,6 @@ class Parser(argparse.ArgumentParser):
 def one_line(text: str) -> str:
     """``text`` with its line breaks and other control characters escaped as ``repr`` does."""
     return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
-
-
-def _non_negative_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"{value} is negative; expected an integer >= 0")
-    return value
-
-
-def _non_negative_float(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not value >= 0 or value == float("inf"):
-        raise argparse.ArgumentTypeError(f"{value:g} is not a finite number >= 0")
-    return value
-
-
-def _registry_kind(text: str) -> str:
-    """A registry's entry-point group from its name, its short name or its singular.
-
-    ``cosim.planners``, ``planners`` and ``planner`` all name the global planners; only
-    the installed packages' metadata is read (no contract is imported).
-    """
-    from cosim.core.registry import registry_names
-
-    names = registry_names()
-    for group in names:
-        short = group.removeprefix("cosim.")
-        singular = short[:-3] + "y" if short.endswith("ies") else short.removesuffix("s")
-        if text in (group, short, singular):
-            return group
-    shorts = [group.removeprefix("cosim.") for group in names]
-    raise argparse.ArgumentTypeError(
-        f"{text!r} is not a registry; expected one of {', '.join(shorts)}"
-    )
-
-
-def _positive_int(text: str) -> int:
-    value = _non_negative_int(text)
-    if value == 0:
-        raise argparse.ArgumentTypeError("0 is not an integer >= 1")
-    return value
-
-
-def _positive_float(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not value > 0 or value == float("inf"):
-        raise argparse.ArgumentTypeError(f"{value:g} is not a finite number > 0")
-    return value
-
-
-def _duration_s(text: str) -> float:
-    """``--duration-s``: within the bounds of ``scenario.duration_s`` (checked alike)."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number of seconds") from None
-    bounds = key_bounds(ScenarioSection, "duration_s")
-    if not math.isfinite(value) or bounds.violation(value) is not None:
-        raise argparse.ArgumentTypeError(
-            f"{value:g} is not a duration {bounds.describe()} s (the bounds of scenario.duration_s)"
-        )
-    return value
-
-
-def _folder(text: str) -> Path:
-    """An output folder's name: not empty, and no NUL byte (no file system takes one)."""
-    if not text or "\0" in text:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a folder name")
-    return Path(text)
-
-
-def _between(text: str, low: float, high: float, what: str, unit: str = "") -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not low <= value <= high:  # NaN too
-        raise argparse.ArgumentTypeError(f"{value:g} is not {what} from {low:g} to {high:g}{unit}")
-    return value
-
-
-def _cell_size_m(text: str) -> float:
-    # the bounds of adapters.mapping.bagmap.RESOLUTION_M (not imported: numpy at start-up)
-    return _between(text, 0.01, 1.0, "a map cell size", " m")
-
-
-def _score(text: str) -> float:
-    return _between(text, 0.0, 1.0, "a score")
-
-
-def _port(text: str) -> int:
-    value = _non_negative_int(text)
-    if value > 65535:
-        raise argparse.ArgumentTypeError(f"{value} is not a TCP port (expected 0 to 65535)")
-    return value
-
-
-def _times(text: str) -> list[float]:
-    values = []
-    for part in text.split(","):
-        try:
-            value = float(part)
-        except ValueError:
-            raise argparse.ArgumentTypeError(
-                f"{part.strip()!r} in {text!r} is not a number; expected times in s, "
-                "comma-separated (e.g. 10,20,30)"
-            ) from None
-        if not value >= 0 or value == float("inf"):
-            raise argparse.ArgumentTypeError(f"{part.strip()} is not a finite time >= 0 (s)")
-        values.append(value)
-    return values
 
 
 def _scenario_argument(parser: argparse.ArgumentParser) -> None:
@@ -201,14 +94,14 @@ def build_parser() -> argparse.ArgumentParser:
     )
     run.add_argument(
         "--out",
-        type=_folder,
+        type=folder,
         help="results folder (default: runs/NAME-seedN, or runs/NAME-seedN-2, -3, ... when "
         "that one holds a run)",
     )
-    run.add_argument("--seed", type=_non_negative_int, help="override scenario.seed")
+    run.add_argument("--seed", type=non_negative_int, help="override scenario.seed")
     run.add_argument(
         "--duration-s",
-        type=_duration_s,
+        type=duration_s,
         help="override scenario.duration_s (s; "
         f"{key_bounds(ScenarioSection, 'duration_s').describe()}, as the key)",
     )
@@ -219,6 +112,13 @@ def build_parser() -> argparse.ArgumentParser:
         "runs/NAME-seedN); other files stay, and figures/ too unless --figures/--gif redraw it",
     )
     run.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    run.add_argument(
+        "--threads",
+        type=threads,
+        help="worker threads for each instant's per-robot work: lidar casts, scan matching "
+        "and map updates, path planning (default: the cores available; 1: one thread). "
+        "The tables and the bag are the same for any number",
+    )
     run.add_argument(
         "--bag",
         choices=("mcap", "sqlite3", "none"),
@@ -238,7 +138,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     live.add_argument("--live", action="store_true", help="serve the run live to Foxglove")
     live.add_argument(
-        "--live-port", type=_port, default=8765, help="TCP port of the live view (default 8765)"
+        "--live-port", type=port, default=8765, help="TCP port of the live view (default 8765)"
     )
     live.add_argument(
         "--live-host",
@@ -248,7 +148,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     live.add_argument(
         "--live-rate",
-        type=_positive_float,
+        type=positive_float,
         default=1.0,
         help="simulated seconds per wall-clock second (default 1.0: real time)",
     )
@@ -267,7 +167,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     unity.add_argument(
         "--unity-port",
-        type=_port,
+        type=port,
         default=10000,
         help="TCP port Unity connects to (default 10000, the Connector's)",
     )
@@ -307,12 +207,12 @@ def build_parser() -> argparse.ArgumentParser:
         ),
     )
     _scenario_argument(world)
-    world.add_argument("--seed", type=_non_negative_int, help="override scenario.seed")
+    world.add_argument("--seed", type=non_negative_int, help="override scenario.seed")
     world.add_argument("--png", type=Path, metavar="F.png", help="write a picture of the world")
     world.add_argument("--map", type=Path, metavar="F.yaml", help="write a map_server map")
     world.add_argument("--sdf", type=Path, metavar="F.sdf", help="write a Gazebo SDF world")
     world.add_argument(
-        "--resolution-m", type=_positive_float, default=0.05, help="map resolution (m/cell)"
+        "--resolution-m", type=positive_float, default=0.05, help="map resolution (m/cell)"
     )
 
     study = commands.add_parser(
@@ -335,7 +235,7 @@ def build_parser() -> argparse.ArgumentParser:
         "(repeatable; values are TOML; not a key the study varies)",
     )
     study.add_argument("--out", type=Path, help="study folder (default: runs/studies/NAME)")
-    study.add_argument("--workers", type=_positive_int, help="local processes (default: cores)")
+    study.add_argument("--workers", type=positive_int, help="local processes (default: cores)")
     study.add_argument(
         "--scheduler",
         metavar="tcp://HOST:PORT",
@@ -343,7 +243,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     study.add_argument(
         "--scheduler-timeout-s",
-        type=_positive_float,
+        type=positive_float,
         default=20.0,
         metavar="S",
         help="how long to wait for the Dask scheduler to answer (default: 20 s)",
@@ -400,13 +300,13 @@ def build_parser() -> argparse.ArgumentParser:
     )
     mapping.add_argument(
         "--resolution-m",
-        type=_cell_size_m,
+        type=cell_size_m,
         default=0.05,
         help="map cell size, 0.01 to 1 m (0.05 m)",
     )
     mapping.add_argument(
         "--min-travel-m",
-        type=_non_negative_float,
+        type=non_negative_float,
         default=0.5,
         help="distance driven before a scan updates the map (slam_toolbox: 0.5 m)",
     )
@@ -418,7 +318,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     mapping.add_argument(
         "--match-margin",
-        type=_score,
+        type=score,
         default=0.0,
         help="score (0..1) by which a matched pose must beat the odometry's prediction "
         "(default 0: corrections of noisy real odometry matter; runs use 0.02)",
@@ -446,7 +346,7 @@ def build_parser() -> argparse.ArgumentParser:
     plot.add_argument("run_dir", metavar="RUN_DIR", type=Path, help="a run's folder")
     plot.add_argument(
         "--at",
-        type=_times,
+        type=times,
         metavar="T1,T2,...",
         help="snapshot times (s), comma-separated (default: evenly spaced over the run)",
     )
@@ -489,12 +389,12 @@ def build_parser() -> argparse.ArgumentParser:
         "kinds",
         nargs="*",
         metavar="KIND",
-        type=_registry_kind,
+        type=registry_kind,
         help="only these registries, by entry-point group (cosim.planners), short name "
         "(planners) or singular (planner); default: all",
     )
     checking = commands.add_parser(
         "check-plugin", help="run cosim's checks of its built-ins on a plugin, one line each"
     )
-    add_check_plugin_arguments(checking, duration_s=_duration_s)
+    add_check_plugin_arguments(checking, duration_s=duration_s)
     return parser

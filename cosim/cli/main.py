@@ -127,6 +127,7 @@ def _run_and_report(args: argparse.Namespace, stop: StopRequest, ran: list[Path]
                 stop=stop,
                 figures=args.figures or args.gif,
                 unity=UnityOptions(args.unity_host, args.unity_port) if args.unity else None,
+                threads=args.threads,
             )
         except RunStopped as stopped:
             if stopped.result is not None and stopped.result.out is not None:

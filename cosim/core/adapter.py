@@ -19,6 +19,7 @@ from cosim.core.kernel import Kernel
 from cosim.core.recorder import Recorder
 from cosim.core.registry import Group
 from cosim.core.rng import RngStreams
+from cosim.core.workers import Workers
 
 T = TypeVar("T")
 
@@ -66,6 +67,8 @@ class RunContext:
         rng: the run's named random streams.
         recorder: the tables being recorded.
         hosts: the hosts of the run, by id, in creation order.
+        workers: the run's threads for per-robot work within one instant (results come
+            back in order: tables are the same for any number of threads).
     """
 
     scenario: ScenarioView
@@ -74,6 +77,7 @@ class RunContext:
     rng: RngStreams
     recorder: Recorder
     hosts: dict[HostId, Host] = field(default_factory=dict)
+    workers: Workers = field(default_factory=Workers)
     _services: dict[type[Any], Any] = field(default_factory=dict)
     _checks: list[Callable[[], None]] = field(default_factory=list)
 

@@ -21,6 +21,7 @@ from typing import Any
 from adapters.unity.server import UnityOptions
 from cosim.core.adapter import AdapterType
 from cosim.core.errors import ConfigError
+from cosim.core.workers import MAX_THREADS, available_cores
 from cosim.recording.foxglove import LiveOptions
 from cosim.runner.stopping import StopRequest
 from cosim.scenario.arguments import (
@@ -31,6 +32,7 @@ from cosim.scenario.arguments import (
     instance_argument,
     optional_seed_argument,
     path_argument,
+    refusal,
     shown,
     wrong_type,
 )
@@ -62,11 +64,13 @@ class RunArguments:
         scenario: the scenario, with the seed and duration asked for.
         out: the run folder, or None.
         adapters: the extra adapters, each a registered name or an adapter class.
+        threads: the run's worker threads (None asked: the cores available).
     """
 
     scenario: Scenario
     out: Path | None
     adapters: tuple[str | AdapterType, ...]
+    threads: int = 1
 
 
 def run_arguments(
@@ -83,6 +87,7 @@ def run_arguments(
     stop: Any,
     figures: Any,
     unity: Any,
+    threads: Any = None,
 ) -> RunArguments:
     """Check every argument of :func:`cosim.run`; load a scenario given by name or file.
 
@@ -116,12 +121,30 @@ def run_arguments(
     if instance_argument(CALL, "unity", unity, UnityOptions, "UnityOptions(...)") is not None:
         _check_address(unity, "unity")
     names = adapters_argument(adapters)
+    checked_threads = threads_argument(CALL, threads)
     loaded = scenario_argument(scenario)
     if checked_seed is not None:
         loaded = loaded.with_seed(checked_seed)
     if checked_duration is not None:
         loaded = loaded.with_duration(checked_duration)
-    return RunArguments(loaded, folder, names)
+    return RunArguments(loaded, folder, names, checked_threads)
+
+
+def threads_argument(call: str, threads: Any) -> int:
+    """Worker threads for a run: an int in ``[1, MAX_THREADS]``, or None (the cores available).
+
+    Raises:
+        ArgumentError: no int (a bool, a float).
+        ConfigError: one out of bounds.
+    """
+    expected = f"an int from 1 to {MAX_THREADS}, or None (the cores available)"
+    if threads is None:
+        return min(available_cores(), MAX_THREADS)
+    if isinstance(threads, bool) or not isinstance(threads, int):
+        raise wrong_type(call, "threads", threads, expected)
+    if not 1 <= threads <= MAX_THREADS:
+        raise ConfigError(refusal(call, "threads", threads, expected))
+    return threads
 
 
 def scenario_argument(scenario: Any) -> Scenario:

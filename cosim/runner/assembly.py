@@ -12,6 +12,7 @@ from cosim.core.kernel import Kernel
 from cosim.core.recorder import Recorder
 from cosim.core.registry import AdapterRegistry, Registry
 from cosim.core.rng import RngStreams
+from cosim.core.workers import Workers
 from cosim.scenario.fields import model_problem
 from cosim.scenario.model import Scenario
 from models.errors import ModelError
@@ -108,6 +109,7 @@ def assemble(
     speed: float = 1.0,
     recording: bool = False,
     extra: Sequence[str] = (),
+    threads: int = 1,
 ) -> Assembly:
     """Build the run context and construct the scenario's adapters.
 
@@ -120,6 +122,7 @@ def assemble(
         speed: simulated seconds per wall-clock second when ``realtime``.
         recording: the run is recorded or viewed live (see :func:`adapter_names`).
         extra: more adapters to run, by name (after the scenario's).
+        threads: the run's worker threads (:class:`cosim.core.workers.Workers`).
     """
     registry = registry or AdapterRegistry.from_entry_points()
     if names is None:
@@ -133,7 +136,12 @@ def assemble(
     recorder = Recorder(record_messages=scenario.record.messages)
     bus = Bus(kernel, tap=recorder)
     run = RunContext(
-        scenario=scenario, kernel=kernel, bus=bus, rng=RngStreams(scenario.seed), recorder=recorder
+        scenario=scenario,
+        kernel=kernel,
+        bus=bus,
+        rng=RngStreams(scenario.seed),
+        recorder=recorder,
+        workers=Workers(threads),
     )
     adapters: list[tuple[str, Adapter]] = []
     for name in ordered:

@@ -64,6 +64,7 @@ def execute(
     stop: StopRequest | None = None,
     figures: bool = False,
     unity: UnityOptions | None = None,
+    threads: int = 1,
 ) -> RunResult:
     """Run a scenario to its duration and return its result.
 
@@ -92,6 +93,8 @@ def execute(
         figures: the caller draws this run's figures into ``out/figures`` afterwards
             (``cosim run --figures``), so ``force`` removes an earlier run's figures too;
             without it they stay (drawn by ``cosim plot``, they are not this run's to remove).
+        threads: worker threads for each instant's per-robot work (1: all on this thread);
+            the tables are the same for any number.
 
     Raises:
         BridgeError: an external system failed while the kernel ran (a physical robot or a
@@ -119,6 +122,7 @@ def execute(
                     realtime=plan.realtime,
                     speed=live.rate if live is not None else 1.0,
                     recording=plan.active,
+                    threads=threads,
                 )
             run = assembly.run
             topics = RecordingSession.topics_of(scenario, run.bus) if plan.active else {}
@@ -260,6 +264,7 @@ def _run_assembled(
         halted, events = True, run.kernel.events_processed - counted
         failure = fault_of(error, doing=doing, t_ns=run.kernel.now_ns)
     finally:
+        run.workers.close()
         for name, adapter in assembly.adapters:
             close = getattr(adapter, "close", None)
             if close is None:
@@ -288,6 +293,7 @@ def _run_assembled(
         "wall_time_s": round(wall_s, 4),
         "real_time_factor": round(reached_s / wall_s, 2) if wall_s > 0 else None,
         "events": events,
+        **run.workers.summary(wall_s),
         "messages_sent": sent,
         "messages_delivered": counts["delivered"],
         "messages_dropped": sent - counts["delivered"],
@@ -372,6 +378,7 @@ def run(
     stop: StopRequest | None = None,
     figures: bool = False,
     unity: UnityOptions | None = None,
+    threads: int | None = None,
 ) -> RunResult:
     """Run a scenario; optionally write its folder.
 
@@ -404,6 +411,10 @@ def run(
             :class:`~cosim.runner.stopping.RunStopped` is raised with the result.
         figures: the caller draws the run's figures into ``out/figures`` afterwards, so
             ``force`` removes an earlier run's figures; without it, ``force`` keeps them.
+        threads: worker threads for each simulated instant's per-robot work (lidar casts,
+            scan matching and map updates, path planning); None: the cores available, 1:
+            all on the calling thread. Tables and bags are the same for any number; the
+            summary says how busy each thread was (``thread_busy_share``).
 
     Returns:
         The run's summary and tables (``summary["wall_time_s"]`` and
@@ -436,6 +447,7 @@ def run(
         stop=stop,
         figures=figures,
         unity=unity,
+        threads=threads,
     )
     scenario, folder = checked.scenario, checked.out
     with _deferred(stop):
@@ -451,6 +463,7 @@ def run(
                 stop=stop,
                 figures=figures,
                 unity=unity,
+                threads=checked.threads,
             )
         except CosimError as error:
             if error.kept is None or folder is None:

@@ -12,9 +12,10 @@ from cosim.core.errors import CosimError
 from cosim.core.recorder import MapArtifact
 from cosim.scenario.model import Scenario
 
-RECORD_KEYS = ("failure", "plugins")
+RECORD_KEYS = ("failure", "plugins", "thread_busy")
 """Summary entries cosim itself writes that are records, not flat metrics: whose fault a
-failed run was (``failure``) and the plugins a run used (``plugins``)."""
+failed run was (``failure``), the plugins a run used (``plugins``) and how busy its
+threads were (``thread_busy``)."""
 
 
 @dataclass

@@ -59,6 +59,18 @@ RUN_KEYS: Mapping[str, SummaryKey] = {
         volatile=True,
     ),
     "events": SummaryKey("count", "kernel events processed"),
+    "threads": SummaryKey(
+        "count",
+        "worker threads of the run (--threads; the tables are the same for any number)",
+        volatile=True,
+    ),
+    "thread_busy": SummaryKey(
+        "record",
+        "each thread's time running per-robot work of an instant (busy_s, s) and its "
+        "share_of_wall (0..1), thread 0 being the run's own; batches: instants spread "
+        "over more than one thread",
+        volatile=True,
+    ),
     "messages_sent": SummaryKey(
         "count", "messages published over the bus, one per destination host"
     ),

@@ -28,6 +28,8 @@ VOLATILE_METRICS = (
     "version",
     "humans_coupling_wall_s",
     "humans_sumo_in_process",
+    "threads",
+    "thread_busy",
 )
 """Summary entries that depend on the machine or executor, not on the scenario and seed."""
 

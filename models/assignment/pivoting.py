@@ -209,11 +209,11 @@ def _pivot_loop_py(
         pivots += 1
 
 
-_exact_sign: Any = numba.njit(cache=True)(_exact_sign_py)
-_perturbation_negative: Any = numba.njit(cache=True)(_perturbation_negative_py)
-_entering: Any = numba.njit(cache=True)(_entering_py)
-_leaving: Any = numba.njit(cache=True)(_leaving_py)
-_pivot_loop: Any = numba.njit(cache=True)(_pivot_loop_py)
+_exact_sign: Any = numba.njit(cache=True, nogil=True)(_exact_sign_py)
+_perturbation_negative: Any = numba.njit(cache=True, nogil=True)(_perturbation_negative_py)
+_entering: Any = numba.njit(cache=True, nogil=True)(_entering_py)
+_leaving: Any = numba.njit(cache=True, nogil=True)(_leaving_py)
+_pivot_loop: Any = numba.njit(cache=True, nogil=True)(_pivot_loop_py)
 
 
 def pivot_loop(

@@ -159,10 +159,10 @@ def _propose_py(
     _arc(x, y, yaw, out[3], out[4], dt_s, out[0], out[1], out[2])
 
 
-_clip: Any = numba.njit(cache=True, inline="always")(_clip_py)
-_wrap: Any = numba.njit(cache=True, inline="always")(wrap_angle)
-_arc: Any = numba.njit(cache=True)(_arc_py)
-_propose: Any = numba.njit(cache=True)(_propose_py)
+_clip: Any = numba.njit(cache=True, nogil=True, inline="always")(_clip_py)
+_wrap: Any = numba.njit(cache=True, nogil=True, inline="always")(wrap_angle)
+_arc: Any = numba.njit(cache=True, nogil=True)(_arc_py)
+_propose: Any = numba.njit(cache=True, nogil=True)(_propose_py)
 
 
 def integrate_fleet(

@@ -259,4 +259,4 @@ def _occupied_blocks_py(data: Int8Array, k: int, occupied: npt.NDArray[np.bool_]
                 occupied[r // k, c // k] = True
 
 
-_occupied_blocks: Any = numba.njit(cache=True)(_occupied_blocks_py)
+_occupied_blocks: Any = numba.njit(cache=True, nogil=True)(_occupied_blocks_py)

@@ -167,6 +167,19 @@ class LogOddsMap:
         self._kernel = np.where(d2 <= r * r, np.round(kernel), 0).astype(np.uint8)
 
     @property
+    def scratch(self) -> Scratch:
+        """The working memory updates of this map use (see :class:`Scratch`)."""
+        return self._scratch
+
+    @scratch.setter
+    def scratch(self, scratch: Scratch) -> None:
+        if scratch.dirty.shape != self.logodds.shape:
+            raise ValueError(
+                f"a scratch of shape {scratch.dirty.shape} for a map of {self.logodds.shape}"
+            )
+        self._scratch = scratch
+
+    @property
     def empty(self) -> bool:
         """Whether no cell is occupied yet (nothing to match against)."""
         return self.occupied_cells == 0

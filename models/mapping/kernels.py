@@ -296,13 +296,13 @@ def _classify_py(logodds: Any, free: Any, occupied: Any, cells: Any) -> None:
             cells[iy, ix] = OCCUPIED if v >= occupied else (FREE if v <= free else UNKNOWN)
 
 
-traverse: Any = numba.njit(cache=True)(_traverse_py)
-classify: Any = numba.njit(cache=True)(_classify_py)
-apply: Any = numba.njit(cache=True)(_apply_py)
-_recompute_score: Any = numba.njit(cache=True)(_recompute_score_py)
-_max4: Any = numba.njit(cache=True, inline="always")(_max4_py)
-_refresh_coarse: Any = numba.njit(cache=True)(_refresh_coarse_py)
-refresh_scores: Any = numba.njit(cache=True)(_refresh_scores_py)
-rebuild_scores: Any = numba.njit(cache=True)(_rebuild_scores_py)
+traverse: Any = numba.njit(cache=True, nogil=True)(_traverse_py)
+classify: Any = numba.njit(cache=True, nogil=True)(_classify_py)
+apply: Any = numba.njit(cache=True, nogil=True)(_apply_py)
+_recompute_score: Any = numba.njit(cache=True, nogil=True)(_recompute_score_py)
+_max4: Any = numba.njit(cache=True, nogil=True, inline="always")(_max4_py)
+_refresh_coarse: Any = numba.njit(cache=True, nogil=True)(_refresh_coarse_py)
+refresh_scores: Any = numba.njit(cache=True, nogil=True)(_refresh_scores_py)
+rebuild_scores: Any = numba.njit(cache=True, nogil=True)(_rebuild_scores_py)
 
 __all__ = ["apply", "rebuild_scores", "refresh_scores", "traverse"]

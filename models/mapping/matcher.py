@@ -403,8 +403,8 @@ def _search_py(
     return best_kx, best_ky, best_a, best, evaluated
 
 
-_add4: Any = numba.njit(cache=True, inline="always")(_add4_py)
-_put4: Any = numba.njit(cache=True)(_put4_py)
-_search: Any = numba.njit(cache=True)(_search_py)
-_sample: Any = numba.njit(cache=True)(_sample_py)
-_refine: Any = numba.njit(cache=True)(_refine_py)
+_add4: Any = numba.njit(cache=True, nogil=True, inline="always")(_add4_py)
+_put4: Any = numba.njit(cache=True, nogil=True)(_put4_py)
+_search: Any = numba.njit(cache=True, nogil=True)(_search_py)
+_sample: Any = numba.njit(cache=True, nogil=True)(_sample_py)
+_refine: Any = numba.njit(cache=True, nogil=True)(_refine_py)

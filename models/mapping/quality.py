@@ -130,8 +130,8 @@ def _count_py(cells: Any, truth: Any, seen: Any, counts: Any) -> None:
                 counts[7] += 1
 
 
-_near: Any = numba.njit(cache=True, inline="always")(_near_py)
-_count: Any = numba.njit(cache=True)(_count_py)
+_near: Any = numba.njit(cache=True, nogil=True, inline="always")(_near_py)
+_count: Any = numba.njit(cache=True, nogil=True)(_count_py)
 
 
 def dilate(cells: BoolArray) -> BoolArray:

@@ -134,4 +134,4 @@ def _response_py(
     return out / (255.0 * n)
 
 
-_response: Any = numba.njit(cache=True)(_response_py)
+_response: Any = numba.njit(cache=True, nogil=True)(_response_py)

@@ -186,8 +186,8 @@ def _costs_of_py(d2: Any, resolution_m: float, table: Any, distance: Any, cost: 
                 cost[r, c] = table[e] if e < size else 0
 
 
-_combine: Any = numba.njit(cache=True)(_combine_py)
-_stamp_points: Any = numba.njit(cache=True)(_stamp_points_py)
-_stamp_discs: Any = numba.njit(cache=True)(_stamp_discs_py)
-_squared_edt: Any = numba.njit(cache=True)(_squared_edt_py)
-_costs_of: Any = numba.njit(cache=True)(_costs_of_py)
+_combine: Any = numba.njit(cache=True, nogil=True)(_combine_py)
+_stamp_points: Any = numba.njit(cache=True, nogil=True)(_stamp_points_py)
+_stamp_discs: Any = numba.njit(cache=True, nogil=True)(_stamp_discs_py)
+_squared_edt: Any = numba.njit(cache=True, nogil=True)(_squared_edt_py)
+_costs_of: Any = numba.njit(cache=True, nogil=True)(_costs_of_py)

@@ -68,6 +68,7 @@ import numpy as np
 from models.arrays import BoolArray, FloatArray, IntArray
 from models.errors import ModelError
 from models.fleet.kinematics import DriveLimits
+from models.slicing import Slices, whole
 
 
 @dataclass(frozen=True)
@@ -156,7 +157,7 @@ def _samples_py(lo: float, hi: float, count: int, out: FloatArray, snap: bool) -
     return used
 
 
-_samples: Any = numba.njit(cache=True)(_samples_py)
+_samples: Any = numba.njit(cache=True, nogil=True)(_samples_py)
 
 
 def _dwa_py(
@@ -310,7 +311,7 @@ def _dwa_py(
             out[i, 3] = min(c0, cap)
 
 
-_dwa: Any = numba.njit(cache=True)(_dwa_py)
+_dwa: Any = numba.njit(cache=True, nogil=True)(_dwa_py)
 
 
 def _csr(start: IntArray, count: int, items: int, name: str) -> IntArray:
@@ -343,6 +344,7 @@ def dwa_batch(
     discs: FloatArray,
     disc_start: IntArray,
     params: DwaParams,
+    slices: Slices = whole,
 ) -> DwaResult:
     """Dynamic Window Approach commands for every robot (see the module docstring).
 
@@ -359,6 +361,8 @@ def dwa_batch(
         discs: (d, 3) obstacle discs ``x, y, r`` in ``map`` (m), e.g. other robots.
         disc_start: (n + 1,) CSR offsets into ``discs``, as ``obstacle_start``.
         params: controller parameters.
+        slices: how to cut the robots for threads (:mod:`models.slicing`); each robot's
+            command is the same whatever the cut.
 
     Returns:
         The commands, blocked flags and clearances, indexed by robot.
@@ -383,5 +387,19 @@ def dwa_batch(
     dsc_start = _csr(disc_start, n, len(dsc), "disc_start")
     cfg = _config(params, limits)
     out = np.zeros((n, 4))
-    _dwa(np.ascontiguousarray(state), pts, pts_start, dsc, dsc_start, cfg, out)
+    rows = np.ascontiguousarray(state)
+
+    def decide(first: int, stop: int) -> None:
+        # the offsets stay absolute: a slice of robots reads its own points and discs
+        _dwa(
+            rows[first:stop],
+            pts,
+            pts_start[first : stop + 1],
+            dsc,
+            dsc_start[first : stop + 1],
+            cfg,
+            out[first:stop],
+        )
+
+    slices(n, decide)
     return DwaResult(out[:, 0].copy(), out[:, 1].copy(), out[:, 2] > 0.5, out[:, 3].copy())

@@ -93,7 +93,7 @@ def _follow_py(
         remaining[r] = total + best_d
 
 
-_follow: Any = numba.njit(cache=True)(_follow_py)
+_follow: Any = numba.njit(cache=True, nogil=True)(_follow_py)
 
 
 @dataclass
@@ -197,7 +197,7 @@ def _blocking_py(
                 break
 
 
-_blocking: Any = numba.njit(cache=True)(_blocking_py)
+_blocking: Any = numba.njit(cache=True, nogil=True)(_blocking_py)
 
 
 def paths_blocked(

@@ -394,9 +394,9 @@ def _prune_py(cost: UInt8Array, cells: IntArray, lethal: int, keep_clearance: bo
 
 
 # numba resolves the helpers when a kernel is first compiled, so their order is free
-_escapes: Any = numba.njit(cache=True)(_escapes_py)
-_landmark_bound: Any = numba.njit(cache=True, inline="always")(_landmark_bound_py)
-_line_ok: Any = numba.njit(cache=True)(_line_ok_py)
-escape_r2: Any = numba.njit(cache=True)(_escape_r2_py)
-astar: Any = numba.njit(cache=True)(_astar_py)
-prune: Any = numba.njit(cache=True)(_prune_py)
+_escapes: Any = numba.njit(cache=True, nogil=True)(_escapes_py)
+_landmark_bound: Any = numba.njit(cache=True, nogil=True, inline="always")(_landmark_bound_py)
+_line_ok: Any = numba.njit(cache=True, nogil=True)(_line_ok_py)
+escape_r2: Any = numba.njit(cache=True, nogil=True)(_escape_r2_py)
+astar: Any = numba.njit(cache=True, nogil=True)(_astar_py)
+prune: Any = numba.njit(cache=True, nogil=True)(_prune_py)

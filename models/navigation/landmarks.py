@@ -49,6 +49,7 @@ then the middles of its walls.
 from __future__ import annotations
 
 import math
+import threading
 import time
 from dataclasses import dataclass, field
 
@@ -160,7 +161,7 @@ def _dijkstra_py(
     return dist
 
 
-_dijkstra = numba.njit(cache=True)(_dijkstra_py)
+_dijkstra = numba.njit(cache=True, nogil=True)(_dijkstra_py)
 
 
 @dataclass(frozen=True, eq=False)
@@ -298,7 +299,8 @@ def build_landmarks(
 class LandmarkCache:
     """The landmark fields of one static costmap, built on first use per cost weight.
 
-    One cache serves every robot planning on the same layer.
+    One cache serves every robot planning on the same layer, also from several threads
+    at once (a field set is built once, under a lock).
 
     Args:
         static: the static layer.
@@ -309,13 +311,19 @@ class LandmarkCache:
         self.static = static
         self.count = count
         self._built: dict[float, Landmarks] = {}
+        self._lock = threading.Lock()
 
     def get(self, cost_weight: float) -> Landmarks:
         """The fields for planning at ``cost_weight`` with the default lethal threshold."""
         key = float(cost_weight)
-        if key not in self._built:
-            self._built[key] = build_landmarks(self.static.cost, count=self.count, cost_weight=key)
-        return self._built[key]
+        built = self._built.get(key)
+        if built is None:
+            with self._lock:
+                built = self._built.get(key)
+                if built is None:
+                    built = build_landmarks(self.static.cost, count=self.count, cost_weight=key)
+                    self._built[key] = built
+        return built
 
 
 __all__ = [

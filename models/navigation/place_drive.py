@@ -75,7 +75,7 @@ def _free_ahead_py(
                 free[i] = min(free[i], touch)
 
 
-_free_ahead: Any = numba.njit(cache=True)(_free_ahead_py)
+_free_ahead: Any = numba.njit(cache=True, nogil=True)(_free_ahead_py)
 
 
 def place_drive(

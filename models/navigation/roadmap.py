@@ -114,7 +114,7 @@ def _hops_to_py(reverse: IntArray, goal: int, out: Int32Array) -> None:
                 tail += 1
 
 
-_hops_to: Any = numba.njit(cache=True)(_hops_to_py)
+_hops_to: Any = numba.njit(cache=True, nogil=True)(_hops_to_py)
 
 
 def segment_clear(

@@ -66,4 +66,4 @@ def _first_per_cell_py(points: FloatArray, keys: IntArray, bits: int, out: Float
     return k
 
 
-_first_per_cell: Any = numba.njit(cache=True)(_first_per_cell_py)
+_first_per_cell: Any = numba.njit(cache=True, nogil=True)(_first_per_cell_py)

@@ -148,7 +148,7 @@ def _moving_py(
     return k
 
 
-_moving: Any = numba.njit(cache=True)(_moving_py)
+_moving: Any = numba.njit(cache=True, nogil=True)(_moving_py)
 
 
 def keep_right(

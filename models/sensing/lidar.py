@@ -226,7 +226,7 @@ def _sensor_model_py(
         out[k] = r
 
 
-_sensor_model: Any = numba.njit(cache=True)(_sensor_model_py)
+_sensor_model: Any = numba.njit(cache=True, nogil=True)(_sensor_model_py)
 
 
 def hits_within(
@@ -306,7 +306,7 @@ def _hits_within_py(
     return k
 
 
-_hits_within: Any = numba.njit(cache=True)(_hits_within_py)
+_hits_within: Any = numba.njit(cache=True, nogil=True)(_hits_within_py)
 
 
 def seen_beyond(
@@ -382,4 +382,4 @@ def _seen_beyond_py(
         out[p] = beam < beams and dist < range_max and seen > dist + tolerance
 
 
-_seen_beyond: Any = numba.njit(cache=True)(_seen_beyond_py)
+_seen_beyond: Any = numba.njit(cache=True, nogil=True)(_seen_beyond_py)

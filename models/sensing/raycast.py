@@ -38,6 +38,7 @@ import numba
 import numpy as np
 
 from models.arrays import FloatArray, IntArray
+from models.slicing import Slices
 
 _PAD_M = 1e-7
 """Growth of every item's shape when binned (m): far above the rounding of the walk,
@@ -147,7 +148,7 @@ def _circle_t_py(
     return t if t >= 0.0 else np.inf
 
 
-_circle_t: Any = numba.njit(cache=True, fastmath=False, inline="always")(_circle_t_py)
+_circle_t: Any = numba.njit(cache=True, nogil=True, fastmath=False, inline="always")(_circle_t_py)
 
 
 def _cast_py(
@@ -245,8 +246,8 @@ def _cast_py(
             out[r, b] = best if best <= range_max else inf
 
 
-_bin: Any = numba.njit(cache=True, fastmath=False)(_bin_py)
-_cast: Any = numba.njit(cache=True, fastmath=False)(_cast_py)
+_bin: Any = numba.njit(cache=True, nogil=True, fastmath=False)(_bin_py)
+_cast: Any = numba.njit(cache=True, nogil=True, fastmath=False)(_cast_py)
 
 
 def _bin_circles_py(
@@ -275,7 +276,7 @@ def _bin_circles_py(
     return start, circles[order], order, circles[spill_ids], spill_ids
 
 
-_bin_circles: Any = numba.njit(cache=True, fastmath=False)(_bin_circles_py)
+_bin_circles: Any = numba.njit(cache=True, nogil=True, fastmath=False)(_bin_circles_py)
 
 
 class StaticScene:
@@ -350,6 +351,7 @@ def cast_batch(
     circles: FloatArray,
     exclude: IntArray,
     range_max_m: float,
+    slices: Slices | None = None,
 ) -> FloatArray:
     """Exact ranges of every beam of every sensor, as :func:`models.sensing.lidar.cast_reference`.
 
@@ -361,6 +363,9 @@ def cast_batch(
         circles: (c, 3) dynamic circles ``x, y, radius`` in ``map`` (m), e.g. robots.
         exclude: (r,) index into ``circles`` each origin must not see (its own body), or -1.
         range_max_m: maximum range (m); farther hits read ``inf``.
+        slices: runs the cast over the sensors cut into slices, e.g. one per thread
+            (``slices(r, cast_rows)`` calls ``cast_rows(start, stop)`` for slices covering
+            ``range(r)``); each sensor's row is the same whatever the cut. None: one slice.
 
     Returns:
         (r, b) float64 distances (m) to the nearest surface; ``inf`` if none within
@@ -375,22 +380,32 @@ def cast_batch(
     out = np.empty((len(org), len(beams)), dtype=np.float64)
     # numpy's cos/sin of r + b angles; the kernel forms the directions from them exactly
     # as models.sensing.lidar.beam_directions does
-    _cast(
-        org,
-        np.cos(yaw),
-        np.sin(yaw),
-        np.cos(beams),
-        np.sin(beams),
-        np.ascontiguousarray(exclude, dtype=np.int64),
-        scene.grid,
-        scene.seg_start,
-        scene.seg_data,
-        start,
-        data,
-        ids,
-        spill,
-        spill_ids,
-        float(range_max_m),
-        out,
-    )
+    cos_yaw, sin_yaw = np.cos(yaw), np.sin(yaw)
+    cos_beam, sin_beam = np.cos(beams), np.sin(beams)
+    own = np.ascontiguousarray(exclude, dtype=np.int64)
+
+    def cast_rows(first: int, stop: int) -> None:
+        _cast(
+            org[first:stop],
+            cos_yaw[first:stop],
+            sin_yaw[first:stop],
+            cos_beam,
+            sin_beam,
+            own[first:stop],
+            scene.grid,
+            scene.seg_start,
+            scene.seg_data,
+            start,
+            data,
+            ids,
+            spill,
+            spill_ids,
+            float(range_max_m),
+            out[first:stop],
+        )
+
+    if slices is None:
+        cast_rows(0, len(org))
+    else:
+        slices(len(org), cast_rows)
     return out

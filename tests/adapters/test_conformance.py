@@ -9,6 +9,7 @@ import cosim
 from cosim.core.adapter import Adapter
 from cosim.core.registry import AdapterRegistry
 from cosim.runner.execute import execute
+from cosim.testing.outcomes import VOLATILE as TESTING_VOLATILE
 
 REGISTRY = AdapterRegistry.from_entry_points()
 SMALL = {
@@ -30,15 +31,9 @@ NEEDS = {
     "humans": {"humans.workers": 3},
 }
 """Scenario keys an adapter needs to have something to do."""
-VOLATILE = {
-    "wall_time_s",
-    "real_time_factor",
-    "max_lateness_ms",
-    "p99_lateness_ms",
-    "late_batches",
-    "humans_coupling_wall_s",  # wall clock spent in SUMO
-    "humans_sumo_in_process",  # libsumo here, or SUMO in a child process: same tables
-}
+VOLATILE = TESTING_VOLATILE
+"""Wall-clock and machine figures (cosim.testing's own list: SUMO's coupling, lateness,
+threads and their busy times)."""
 
 
 def test_the_registry_holds_the_core_adapters():

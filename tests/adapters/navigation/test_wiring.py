@@ -13,6 +13,7 @@ from cosim.core.hosts import HostId
 from cosim.core.kernel import Kernel
 from cosim.core.messages import LaserScan, Message, NavGoal, NavStatus, Path, Twist
 from cosim.core.messages import OccupancyGrid as GridMessage
+from cosim.core.workers import Workers
 
 NAMES = ["robot_1", "robot_2"]
 HOSTS = [HostId(n) for n in NAMES]
@@ -30,13 +31,17 @@ class Heard:
     def add(self, i: int, pose: np.ndarray, ranges: np.ndarray) -> None:
         self.calls.append(("scan", i, pose, ranges))
 
-    def update(self, i: int, message: GridMessage) -> None:
-        self.calls.append(("map", i, message))
+    def build(self, i: int, message: GridMessage) -> tuple[int, GridMessage]:
+        return (i, message)  # what the layer would be built from
+
+    def set(self, i: int, built: tuple[int, GridMessage]) -> None:
+        self.calls.append(("map", i, built[1]))
 
 
 def _wired(*, mapping: bool) -> tuple[Bus, Any, NavWiring, Heard, np.ndarray]:
-    bus = Bus(Kernel())
-    run: Any = SimpleNamespace(bus=bus)
+    kernel = Kernel()
+    bus = Bus(kernel)
+    run: Any = SimpleNamespace(bus=bus, kernel=kernel, workers=Workers(1))
     interface = NavWiring.of(NAMES, HOSTS)
     heard: Any = Heard()
     pose = np.array([[1.0, 2.0, 0.0], [3.0, 4.0, 0.5]])
@@ -84,8 +89,10 @@ def test_maps_are_heard_only_when_robots_build_their_own():
     bus, _, _, heard, _ = _wired(mapping=False)
     bus.publish("/robot_1/map", grid, HOSTS[0])
     assert heard.calls == []
-    bus, _, _, heard, _ = _wired(mapping=True)
+    bus, run, _, heard, _ = _wired(mapping=True)
     bus.publish("/robot_1/map", grid, HOSTS[0])
+    assert heard.calls == []  # built with the instant's other maps, at the stage's end
+    run.kernel.run(1)
     assert heard.calls == [("map", 0, grid)]
 
 

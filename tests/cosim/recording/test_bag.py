@@ -160,7 +160,7 @@ def test_tables_are_the_same_with_and_without_a_bag(tmp_path):
     assert with_bag.bag is not None and without.bag is None
     for name, frame in without.deterministic_tables().items():
         assert with_bag.deterministic_tables()[name].equals(frame), name
-    machine = {"wall_time_s", "real_time_factor", "plugins"}
+    machine = {"wall_time_s", "real_time_factor", "thread_busy", "plugins"}
     assert {k: v for k, v in with_bag.summary.items() if k not in machine} == {
         k: v for k, v in without.summary.items() if k not in machine
     }

@@ -100,6 +100,9 @@ def refused_naming(error: CosimError, argument: str) -> None:
         ({"unity": UnityOptions(host="no host")}, "cosim.run(unity=...): unity.host = 'no host'"),
         ({"stop": True}, "cosim.run(stop=True): expected a StopRequest"),
         ({"duration_s": "5"}, "cosim.run(duration_s='5'): expected a number of seconds"),
+        ({"threads": 0}, "cosim.run(threads=0): expected an int from 1 to 64, or None"),
+        ({"threads": 2.0}, "cosim.run(threads=2.0): expected an int from 1 to 64, or None"),
+        ({"threads": True}, "cosim.run(threads=True): expected an int from 1 to 64, or None"),
     ],
 )
 def test_a_wrong_argument_is_refused_in_one_line_before_anything_runs(tiny, tmp_path, kwargs, line):

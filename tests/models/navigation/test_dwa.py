@@ -1,3 +1,4 @@
+import itertools
 import math
 
 import numpy as np
@@ -292,3 +293,33 @@ def test_invalid_parameters_and_inputs_are_rejected():
         _call((0.0, 0.0, 0.0), (0.0, 0.0), (1.0, 0.0), (1.0, 0.0), [[1.0, 1.0]], np.array([0, 2]))
     with pytest.raises(ValueError, match="velocities"):
         _call((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (1.0, 0.0), (1.0, 0.0), [])
+
+
+def _cut_at(edges):
+    """A ``slices`` function that cuts the robots at ``edges`` (sorted, within the count)."""
+
+    def slices(count, rows):
+        bounds = [0, *[e for e in edges if 0 < e < count], count]
+        for start, stop in itertools.pairwise(bounds):
+            rows(start, stop)
+
+    return slices
+
+
+@pytest.mark.parametrize("edges", [[], [1], [5], [3, 4, 9], list(range(1, 10))])
+def test_commands_are_the_same_whatever_the_robots_are_cut_into(edges):
+    rng = np.random.default_rng(11)
+    spec = WarehouseSpec(size_m=(12.0, 12.0), shelf_count=4, robot_count=10, placement="random")
+    world = generate_warehouse(spec, rng)
+    fleet = FleetState([f"r{i}" for i in range(10)], world.starts, RADIUS)
+    points, start = _scan(StaticScene(world.segments()), fleet)
+    velocities = np.column_stack([rng.uniform(0, 1, 10), rng.uniform(-1, 1, 10)])
+    carrots = world.starts[:, :2] + rng.uniform(-2.0, 2.0, (10, 2))
+    # robot i hears of robot i + 1 (the last of the first)
+    discs = np.column_stack([np.roll(world.starts[:, :2], -1, axis=0), np.full(10, RADIUS)])
+    disc_start = np.arange(11, dtype=np.int64)
+    args = (world.starts, velocities, LIMITS, np.full(10, RADIUS), carrots, carrots)
+    whole = dwa_batch(*args, points, start, discs, disc_start, PARAMS)
+    cut = dwa_batch(*args, points, start, discs, disc_start, PARAMS, _cut_at(edges))
+    for a, b in zip(whole, cut, strict=True):
+        assert np.array_equal(a, b)

@@ -1,3 +1,4 @@
+import itertools
 import math
 
 import numpy as np
@@ -343,3 +344,23 @@ def test_ranges_do_not_depend_on_the_scene_cell():
     ]
     for other in ranges[1:]:
         np.testing.assert_array_equal(other, ranges[0])
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_ranges_are_the_same_whatever_the_sensors_are_cut_into(seed):
+    rng = np.random.default_rng(seed)
+    world = _random_world(rng)
+    scene = StaticScene(world.segments())
+    n = len(world.starts)
+    beams = np.linspace(-math.pi, math.pi, 90, endpoint=False)
+    circles = np.column_stack([world.starts[:, :2], np.full(n, 0.3)])
+    args = (scene, world.starts[:, :2], world.starts[:, 2], beams, circles, np.arange(n), 10.0)
+    whole = cast_batch(*args)
+    cuts = sorted(set(rng.integers(1, n, size=2).tolist()))
+
+    def slices(count, rows):
+        bounds = [0, *cuts, count]
+        for start, stop in itertools.pairwise(bounds):
+            rows(start, stop)
+
+    assert np.array_equal(cast_batch(*args, slices=slices), whole)
