@@ -21,6 +21,7 @@ from recording_bench import bag_cost, bag_memory_1h, encoding
 from scale_bench import fleet_scaling
 from startup_bench import cli_startup
 from study_bench import study_throughput_200
+from threads_bench import threads_speedup
 
 import cosim
 from cosim.core.adapter import RunContext
@@ -436,6 +437,7 @@ SUITES: dict[str, Callable[[int], Result]] = {
     "humans_coupling": humans_coupling,
     "cli_startup": cli_startup,
     "peers": irsim_peer,
+    "threads": threads_speedup,
 }
 
 ON_REQUEST = {"peers"}

@@ -145,16 +145,18 @@ class DtaAdapter:
         """Subscribe every robot to tasks, claims, protocol messages and its navigation."""
         bus = run.bus
         for robot, host in zip(self.robots, self.hosts, strict=True):
-            on = self._on(run, robot)
-            bus.subscribe(TASKS, host, on)
-            bus.subscribe(CLAIMS, host, on)
+            # one handler per topic: each topic carries one advertised type (the bus refuses
+            # others), so a message is handed on without asking what it is
+            on = self._handlers(run, robot)
+            bus.subscribe(TASKS, host, on["tasks"])
+            bus.subscribe(CLAIMS, host, on["claim"])
             if self.protocol.topic is not None:
-                bus.subscribe(self.protocol.topic, host, on)
-            bus.subscribe(reply_topic(robot.name), host, on)
-            bus.subscribe(ack_topic(robot.name), host, on)
-            bus.subscribe(order_topic(robot.name), host, on)
-            bus.subscribe(status_topic(robot.name), host, on)
-            bus.subscribe(odom_topic(robot.name), host, on)
+                bus.subscribe(self.protocol.topic, host, on["exchanged"])
+            bus.subscribe(reply_topic(robot.name), host, on["reply"])
+            bus.subscribe(ack_topic(robot.name), host, on["done"])
+            bus.subscribe(order_topic(robot.name), host, on["order"])
+            bus.subscribe(status_topic(robot.name), host, on["nav"])
+            bus.subscribe(odom_topic(robot.name), host, on["odom"])
         if self.cfg.round_phase == "aligned":
             run.kernel.every(self.period_ns, lambda now: self._round(run, now), stage=Stage.CONTROL)
         else:
@@ -173,31 +175,61 @@ class DtaAdapter:
         if self.protocol.central:  # the base station decides from the robots' poses
             run.kernel.every(s_to_ns(1.0), lambda now: self._report(run, now), stage=Stage.CONTROL)
 
-    def _on(self, run: RunContext, robot: RobotTasks) -> Callable[[Message, Envelope], None]:
+    def _handlers(
+        self, run: RunContext, robot: RobotTasks
+    ) -> dict[str, Callable[[Message, Envelope], None]]:
+        """``robot``'s handler of each topic it hears, by what the topic carries."""
         exchanged = self.protocol.message
+        duties = self.duties
+        pose = self.pose
+        index = robot.index
 
-        def on(message: Message, envelope: Envelope) -> None:
-            if isinstance(message, Odometry):
-                self.pose[robot.index] = (message.x_m, message.y_m)
-            elif isinstance(message, TaskSet):
-                self._on_tasks(run, robot, message)
-            elif exchanged is not None and isinstance(message, exchanged):
-                sender: Any = message  # the contract: protocol messages carry epoch and robot
-                if sender.epoch == robot.epoch and sender.robot != robot.name:
-                    robot.inbox.append(message)
-            elif isinstance(message, TaskClaim):
-                self.duties.on_claim(run, robot, message)
-            elif isinstance(message, NavStatus):
-                self.duties.on_nav(run, robot, message)
-            elif isinstance(message, ServiceReply):
-                self.duties.on_reply(run, robot, message)
-            elif isinstance(message, TaskDone):
-                if robot.phase == "reporting" and message.task_id == robot.task:
-                    self.duties.become_idle(robot)  # the source acknowledged
-            elif isinstance(message, TaskOrder):
-                self.duties.on_order(run, robot, message)
+        def odom(message: Message, _envelope: Envelope) -> None:
+            assert isinstance(message, Odometry)
+            pose[index] = (message.x_m, message.y_m)
 
-        return on
+        def tasks(message: Message, _envelope: Envelope) -> None:
+            assert isinstance(message, TaskSet)
+            self._on_tasks(run, robot, message)
+
+        def protocol(message: Message, _envelope: Envelope) -> None:
+            if exchanged is None or not isinstance(message, exchanged):
+                return
+            sender: Any = message  # the contract: protocol messages carry epoch and robot
+            if sender.epoch == robot.epoch and sender.robot != robot.name:
+                robot.inbox.append(message)
+
+        def claim(message: Message, _envelope: Envelope) -> None:
+            assert isinstance(message, TaskClaim)
+            duties.on_claim(run, robot, message)
+
+        def nav(message: Message, _envelope: Envelope) -> None:
+            assert isinstance(message, NavStatus)
+            duties.on_nav(run, robot, message)
+
+        def reply(message: Message, _envelope: Envelope) -> None:
+            assert isinstance(message, ServiceReply)
+            duties.on_reply(run, robot, message)
+
+        def done(message: Message, _envelope: Envelope) -> None:
+            assert isinstance(message, TaskDone)
+            if robot.phase == "reporting" and message.task_id == robot.task:
+                duties.become_idle(robot)  # the source acknowledged
+
+        def order(message: Message, _envelope: Envelope) -> None:
+            assert isinstance(message, TaskOrder)
+            duties.on_order(run, robot, message)
+
+        return {
+            "odom": odom,
+            "tasks": tasks,
+            "exchanged": protocol,
+            "claim": claim,
+            "nav": nav,
+            "reply": reply,
+            "done": done,
+            "order": order,
+        }
 
     # -- epochs and rounds -------------------------------------------------------------------
     def _on_tasks(self, run: RunContext, robot: RobotTasks, tasks: TaskSet) -> None:

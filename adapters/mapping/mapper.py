@@ -175,6 +175,7 @@ class MappingAdapter:
         )
         self.sharing: MapSharing = sharing(context)
         self.recorder = run.recorder
+        self.workers = run.workers
         # with a robots layer each robot hears where the others are: returns off them are
         # left out of its map and its matching (robots are not the building); whether one
         # runs is known once every adapter is built (the navigation provides it)
@@ -290,12 +291,12 @@ class MappingAdapter:
         bus.publish(FLEET_MAP, occupancy_message(now_ns, merged(self.maps)), BASE_HOST)
 
     def _sample(self, now_ns: int) -> None:
-        self.records.sample(now_ns, self.maps, merged(self.maps))
+        self.records.sample(now_ns, self.maps, merged(self.maps), self.workers.map)
 
     def finish(self, run: RunContext) -> Mapping[str, Any]:
         """Final quality, errors and sharing; the final maps for the run folder."""
         fleet = merged(self.maps)
-        self.records.sample(run.kernel.now_ns, self.maps, fleet)
+        self.records.sample(run.kernel.now_ns, self.maps, fleet, self.workers.map)
         for name, grid in zip(self.names, self.maps, strict=True):
             self.recorder.add_map(name, grid.occupancy_grid())
         self.recorder.add_map("fleet", fleet)

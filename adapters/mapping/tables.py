@@ -26,9 +26,10 @@ from cosim.core.recorder import Recorder
 from cosim.core.summary import SummaryKey
 from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S
+from cosim.core.workers import Spread, in_turn
 from models.geometry.occupancy import OccupancyGrid, rasterize_boxes
 from models.mapping.grid import LogOddsMap, MapGeometry
-from models.mapping.quality import Int8Array, MapScores, map_scores, observable
+from models.mapping.quality import MapScores, map_scores, observable
 from models.world.warehouse import Warehouse
 
 MAPPING_SUMMARY: Mapping[str, SummaryKey] = {
@@ -212,22 +213,40 @@ class MappingRecords:
         self.shared_messages += 1
         self.shared_bytes += nbytes
 
-    def sample(self, t_ns: int, maps: list[LogOddsMap], fleet: OccupancyGrid) -> None:
-        """A row per robot and one for the fleet (its maps fused): quality now."""
+    def sample(
+        self,
+        t_ns: int,
+        maps: list[LogOddsMap],
+        fleet: OccupancyGrid,
+        spread: Spread = in_turn,
+    ) -> None:
+        """A row per robot and one for the fleet (its maps fused): quality now.
+
+        Args:
+            t_ns: now (ns).
+            maps: every robot's map.
+            fleet: the fleet's fused map.
+            spread: runs the maps' scoring (``spread(fn, items)``, results in order), e.g.
+                on the run's threads; the rows are the same.
+        """
         t_s = t_ns / NS_PER_S
         every: list[float] = []
         every_odom: list[float] = []
-        for i, grid in enumerate(maps):
-            cells = grid.occupancy()
-            self._row(t_s, self.names[i], cells, self.errors[i], self.odom_errors[i])
+
+        def score(k: int) -> MapScores:
+            cells = maps[k].occupancy() if k < len(maps) else fleet.data
+            return map_scores(cells, self.truth, self.seen)
+
+        scores = spread(score, range(len(maps) + 1))
+        for i in range(len(maps)):
+            self._row(t_s, self.names[i], scores[i], self.errors[i], self.odom_errors[i])
             every += self.errors[i]
             every_odom += self.odom_errors[i]
-        self._row(t_s, FLEET, fleet.data, every, every_odom)
+        self._row(t_s, FLEET, scores[-1], every, every_odom)
 
     def _row(
-        self, t_s: float, robot: str, cells: Int8Array, errors: list[float], odom: list[float]
+        self, t_s: float, robot: str, scores: MapScores, errors: list[float], odom: list[float]
     ) -> None:
-        scores = map_scores(cells, self.truth, self.seen)
         self.last[robot] = scores
         self.quality.append(
             t_s=t_s,

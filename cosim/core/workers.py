@@ -23,13 +23,29 @@ import os
 import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
-from typing import Any, TypeVar
+from typing import Any, Protocol, TypeVar
 
 T = TypeVar("T")
 R = TypeVar("R")
 
 MAX_THREADS = 64
 """The most threads a run takes (more than any machine cosim targets has cores)."""
+
+
+class Spread(Protocol):
+    """Something that runs ``fn`` over ``items`` and returns the results in order.
+
+    :meth:`Workers.map` is one (on the run's threads); :func:`in_turn` the plain one.
+    """
+
+    def __call__(self, fn: Callable[[T], R], items: Sequence[T], /) -> list[R]:
+        """The results of ``fn`` over ``items``, in the items' order."""
+        ...
+
+
+def in_turn(fn: Callable[[T], R], items: Sequence[T], /) -> list[R]:
+    """``[fn(item) for item in items]`` on the calling thread."""
+    return [fn(item) for item in items]
 
 
 def available_cores() -> int:
@@ -152,4 +168,4 @@ class Workers:
         return self._pool
 
 
-__all__ = ["MAX_THREADS", "Workers", "available_cores"]
+__all__ = ["MAX_THREADS", "Spread", "Workers", "available_cores", "in_turn"]
