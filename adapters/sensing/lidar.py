@@ -61,14 +61,20 @@ class LidarAdapter:
         names = self.fleet.names
         beams = self.geometry.beams
         # float32 draws: the published ranges are float32 anyway
+        # each robot's stream refilled on the run's threads (the same numbers)
+        spread = run.workers.map
         self.noise = BlockDraws(
-            [run.rng.stream(f"lidar/{n}/noise") for n in names], beams, dtype=np.float32
+            [run.rng.stream(f"lidar/{n}/noise") for n in names],
+            beams,
+            dtype=np.float32,
+            spread=spread,
         )
         self.dropout = BlockDraws(
             [run.rng.stream(f"lidar/{n}/dropout") for n in names],
             beams,
             kind="uniform",
             dtype=np.float32,
+            spread=spread,
         )
         self._zeros = np.zeros((len(names), beams), dtype=np.float32)
         self._ones = np.ones((len(names), beams), dtype=np.float32)

@@ -14,6 +14,8 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from cosim.core.workers import Spread, in_turn
+
 
 def _name_key(name: str) -> tuple[int, ...]:
     digest = hashlib.sha256(name.encode("utf-8")).digest()
@@ -47,6 +49,10 @@ class RngStreams:
         return np.random.Generator(np.random.PCG64(sequence))
 
 
+BLOCK_TICKS = 64
+"""Ticks a :class:`BlockDraws` fetches at once, at most."""
+
+
 class BlockDraws:
     """Random draws for many components, each from its own stream, fetched in blocks.
 
@@ -60,6 +66,9 @@ class BlockDraws:
         kind: ``"normal"`` (standard normal) or ``"uniform"`` (in [0, 1)).
         budget: maximum number of buffered values (bounds the memory).
         dtype: ``numpy.float64`` or ``numpy.float32`` (twice as fast to draw).
+        spread: refills the components' rows (``spread(fn, rows)``, e.g. the run's
+            threads: :meth:`cosim.core.workers.Workers.map`); each row is drawn from its own
+            stream, so the numbers are the same however the rows are spread.
     """
 
     def __init__(
@@ -69,13 +78,16 @@ class BlockDraws:
         kind: str = "normal",
         budget: int = 1 << 22,
         dtype: type[np.floating[Any]] = np.float64,
+        spread: Spread = in_turn,
     ) -> None:
         if kind not in ("normal", "uniform"):
             raise ValueError(f"kind must be 'normal' or 'uniform', got {kind!r}")
         self.streams = streams
         self.width = width
         self.kind = kind
-        self.block = max(1, min(256, budget // max(1, len(streams) * width)))
+        # at most BLOCK_TICKS ticks ahead: what a run's last block draws past its end is lost
+        self.block = max(1, min(BLOCK_TICKS, budget // max(1, len(streams) * width)))
+        self.spread = spread
         self.dtype = dtype
         self._buffer = np.zeros((len(streams), self.block, width), dtype=dtype)
         self._next = self.block
@@ -83,13 +95,20 @@ class BlockDraws:
     def draw(self) -> npt.NDArray[np.floating[Any]]:
         """Return (components, width) draws; a view, valid until the next call."""
         if self._next == self.block:
-            shape = (self.block, self.width)
-            for row, stream in enumerate(self.streams):
-                if self.kind == "normal":
-                    self._buffer[row] = stream.standard_normal(shape, dtype=self.dtype)
-                else:
-                    self._buffer[row] = stream.random(shape, dtype=self.dtype)
+            self.spread(self._refill, range(len(self.streams)))
             self._next = 0
         out = self._buffer[:, self._next, :]
         self._next += 1
         return out
+
+    def _refill(self, row: int) -> None:
+        """The next ``block`` ticks of component ``row``, from its own stream.
+
+        numpy draws into the buffer without holding the interpreter lock, so rows refill
+        at once on several threads.
+        """
+        stream, out = self.streams[row], self._buffer[row]
+        if self.kind == "normal":
+            stream.standard_normal(out=out, dtype=self.dtype)
+        else:
+            stream.random(out=out, dtype=self.dtype)
