@@ -194,16 +194,24 @@ class FleetPlaces:
 
     def release(self, xy: FloatArray) -> None:
         """Let go of the places a robot's body has left (all but its own place)."""
-        rm = self.roadmap
+        robots: list[int] = []
+        places: list[int] = []
         for i in range(len(xy)):
-            if not self.held[i] or self.mode[i] == APPROACH:
-                continue
-            keep = [
-                u
-                for u in self.held[i]
-                if u == self.node[i] or np.hypot(*(xy[i] - rm.xy[u])) < RELEASE_M
+            if self.held[i] and self.mode[i] != APPROACH:
+                robots += [i] * len(self.held[i])
+                places += self.held[i]
+        if not robots:
+            return
+        # every held place's distance at once (the same numbers as one place at a time)
+        gap = np.hypot(*(xy[robots] - self.roadmap.xy[places]).T).tolist()
+        k = 0
+        for i in dict.fromkeys(robots):
+            held = self.held[i]
+            near = gap[k : k + len(held)]
+            k += len(held)
+            self.held[i] = [
+                u for u, d in zip(held, near, strict=True) if u == self.node[i] or d < RELEASE_M
             ]
-            self.held[i] = keep
 
     def remaining(self, xy: FloatArray, active: BoolArray) -> FloatArray:
         """Way left to each goal (m), 0 for robots without one (see :meth:`_ways`)."""

@@ -162,6 +162,13 @@ def test_a_numpy_seed_runs_and_is_written_as_a_plain_int(tiny, tmp_path):
 ARGUMENTS = sorted(DEFAULTS)
 
 
+def _long(value: object) -> bool:
+    """A number of seconds longer than a test should simulate (valid or not)."""
+    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+        return False
+    return bool(np.isfinite(float(value)) and float(value) > 1.0)
+
+
 @settings(
     max_examples=120,
     deadline=None,
@@ -174,6 +181,16 @@ def test_any_value_of_any_argument_runs_or_is_refused_in_one_line_naming_it(
     if argument in ("live", "unity") and isinstance(value, LiveOptions | UnityOptions):
         return  # a valid one serves the run in real time: checked without running, below
     folder = tmp_path_factory.mktemp("fuzz")
+    if argument == "duration_s" and _long(value):
+        # a long duration is taken or refused as the run would: checked without running
+        # it for hours
+        try:
+            checked = run_arguments(tiny, **{**DEFAULTS, "duration_s": value})
+        except ConfigError as error:
+            refused_naming(error, argument)
+        else:
+            assert checked.scenario.scenario.duration_s == float(value)
+        return
     with contextlib.chdir(folder):
         try:
             result = cosim.run(tiny, **{argument: value})
