@@ -85,9 +85,10 @@ class Workers:
     def map(self, fn: Callable[[T], R], items: Sequence[T]) -> list[R]:
         """``[fn(item) for item in items]``, the items spread over the threads.
 
-        Results come back in the items' order whatever ran first. An item that raises
-        raises here, on the calling thread, once every item has finished (the first
-        failure in the items' order; no thread carries on past a half-done instant).
+        Results come back in the items' order whatever ran first. An item that raises an
+        ``Exception`` raises here, on the calling thread, once every item has finished (the
+        first failure in the items' order; no thread carries on past a half-done instant).
+        An interrupt on the calling thread (Ctrl-C, the watchdog) leaves at once.
         """
         count = len(items)
         helpers = min(self.threads, count) - 1
@@ -109,8 +110,9 @@ class Workers:
                     break
                 try:
                     results[k] = fn(items[k])
-                except BaseException as error:  # raised on the run's thread, in order
+                except Exception as error:  # raised on the run's thread, in order
                     failures[k] = error
+                # anything else (an interrupt, a stop, the watchdog) leaves at once
             self._busy_s[slot] += time.perf_counter() - start
 
         pool = self._executor()
@@ -157,9 +159,13 @@ class Workers:
         }
 
     def close(self) -> None:
-        """Stop the helper threads (they hold no work between instants)."""
+        """Let the helper threads go (they hold no work between instants).
+
+        Not waited for: after a run that failed mid-batch (a plugin's item hung and the
+        watchdog ended the run), a helper may still be inside that item.
+        """
         if self._pool is not None:
-            self._pool.shutdown(wait=True)
+            self._pool.shutdown(wait=False, cancel_futures=True)
             self._pool = None
 
     def _executor(self) -> ThreadPoolExecutor:

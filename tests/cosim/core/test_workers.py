@@ -123,3 +123,20 @@ def test_the_compiled_kernels_release_the_interpreter_lock() -> None:
     # nogil=True is what lets two threads cast at once; a kernel compiled without it
     # would still be correct, only serial: said by numba's own flag
     assert _cast.targetoptions.get("nogil") is True
+
+
+def test_an_interrupt_on_the_run_s_thread_leaves_the_batch_at_once() -> None:
+    workers = Workers(2)
+
+    def work(item: int) -> int:
+        if threading.current_thread() is threading.main_thread():
+            raise KeyboardInterrupt  # Ctrl-C, or the watchdog, while the run's thread works
+        time.sleep(0.001)
+        return item
+
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            # with 200 short items the run's thread surely takes one
+            workers.map(work, list(range(200)))
+    finally:
+        workers.close()
