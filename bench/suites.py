@@ -241,7 +241,7 @@ class Chatter:
 BREAKDOWN = {
     "lidar (cast, noise, scan messages)": ("adapters/sensing/lidar.py", "_scan"),
     "navigation control tick (all below)": ("adapters/navigation/stack.py", "_control"),
-    "  global planning (A*, costmap, memory)": ("adapters/navigation/planning.py", "plan"),
+    "  global planning (A*, costmap, memory)": ("adapters/navigation/planning.py", "route"),
     "  local control (DWA kernel)": ("models/navigation/dwa.py", "dwa_batch"),
     "physics tick (kinematics, collisions, odometry)": ("adapters/fleet/motion.py", "_tick"),
     "  collision checks": ("adapters/fleet/collisions.py", "guard"),
@@ -257,7 +257,7 @@ def _shares(scenario: cosim.Scenario, breakdown: dict[str, tuple[str, str]]) -> 
 
     profiler = cProfile.Profile()
     profiler.enable()
-    result = cosim.run(scenario)
+    result = cosim.run(scenario, threads=1)  # cProfile sees one thread: all the work on it
     profiler.disable()
     stats = pstats.Stats(profiler).stats  # type: ignore[attr-defined]
     total = sum(v[2] for v in stats.values())
@@ -309,8 +309,12 @@ maps)."""
 FULL_STACK_BREAKDOWN = {
     "task assignment rounds (protocol, broadcasts)": ("adapters/assignment/dta.py", "_round_of"),
     "  distributed simplex merge and solve": ("models/assignment/dsimplex.py", "merge_and_solve"),
-    "mapping: scan matching (every scan)": ("adapters/mapping/mapper.py", "on_scan"),
-    "mapping: map updates (every 5 s)": ("adapters/mapping/mapper.py", "_publish_maps"),
+    "mapping: scan matching and map updates (every 0.5 m)": (
+        "adapters/mapping/mapper.py",
+        "_process",
+    ),
+    "mapping: maps out (every 5 s)": ("adapters/mapping/mapper.py", "_publish_maps"),
+    "navigation: new maps' costmaps": ("adapters/navigation/layers.py", "build"),
     **BREAKDOWN,
 }
 
