@@ -15,7 +15,9 @@ Bytes per cell, as :mod:`models.mapping.grid` and the adapter allocate them:
   map the run keeps (int8, 1): 9; with a sharing mode that tracks changes
   (``share = "maps"``), the log-odds not yet sent (float32, 4) more;
 - shared: the update's scratch (int32 stamp, uint8 dirty flag: 5), the fleet map and the
-  ground truth the map quality is measured against, with its masks (about 11): 16.
+  ground truth the map quality is measured against, with its masks (about 11): 16;
+- each thread of the run that maps (``--threads``, at most the cores available): its own
+  scratch (5).
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from adapters.mapping.geometry import MARGIN_M
 from adapters.mapping.settings import MappingConfig
 from cosim.core.errors import ConfigError
 from cosim.core.memory import Room, available, size_text, smallest_fitting
+from cosim.core.workers import MAX_THREADS, available_cores
 from cosim.scenario.fields import format_problem, key_bounds
 from cosim.scenario.model import Scenario
 from cosim.scenario.sections import RobotsConfig, WorldConfig
@@ -37,6 +40,8 @@ CHANGES_BYTES_PER_CELL = 4
 """Each robot's unsent log-odds, with a sharing mode that tracks changes (bytes per cell)."""
 SHARED_BYTES_PER_CELL = 16
 """The scratch, fleet map and ground truth every robot's map shares (bytes per cell)."""
+THREAD_BYTES_PER_CELL = 5
+"""Each mapping thread's own scratch (bytes per cell)."""
 
 
 def map_shape(world: WorldConfig, resolution_m: float) -> tuple[int, int]:
@@ -55,7 +60,9 @@ def mapping_bytes(scenario: Scenario, resolution_m: float | None = None) -> int:
     if MAP_SHARING.installed().get(cfg.share).tracks_changes:
         per_robot += CHANGES_BYTES_PER_CELL
     robots = scenario.section(RobotsConfig).count
-    return cols * rows * (robots * per_robot + SHARED_BYTES_PER_CELL)
+    # a run takes the cores available unless told fewer threads: count a scratch for each
+    threads = THREAD_BYTES_PER_CELL * min(available_cores(), MAX_THREADS)
+    return cols * rows * (robots * per_robot + SHARED_BYTES_PER_CELL + threads)
 
 
 def check_mapping_memory(scenario: Scenario, room: Room | None = None) -> None:

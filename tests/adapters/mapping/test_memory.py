@@ -8,6 +8,7 @@ from adapters.mapping.memory import (
     CHANGES_BYTES_PER_CELL,
     ROBOT_BYTES_PER_CELL,
     SHARED_BYTES_PER_CELL,
+    THREAD_BYTES_PER_CELL,
     check_mapping_memory,
     map_shape,
     mapping_bytes,
@@ -15,6 +16,7 @@ from adapters.mapping.memory import (
 from adapters.world.warehouse import scenario_warehouse
 from cosim.core.errors import ConfigError
 from cosim.core.memory import Room
+from cosim.core.workers import available_cores
 from cosim.runner.assembly import check_scenario
 
 GIB = 1 << 30
@@ -33,7 +35,9 @@ def test_the_estimate_counts_the_cells_of_the_maps_the_robots_build(resolution_m
 
 def test_every_robot_s_map_counts_and_maps_sent_as_changes_count_more():
     cols, rows = map_shape(mapping().world, 0.05)
-    shared = cols * rows * SHARED_BYTES_PER_CELL
+    # each thread a run may take (the cores available) has a scratch of its own
+    threads = THREAD_BYTES_PER_CELL * available_cores()
+    shared = cols * rows * (SHARED_BYTES_PER_CELL + threads)
     assert mapping_bytes(mapping()) == cols * rows * 50 * ROBOT_BYTES_PER_CELL + shared
     sent = mapping(**{"mapping.share": "maps"})
     per_robot = ROBOT_BYTES_PER_CELL + CHANGES_BYTES_PER_CELL
@@ -41,7 +45,10 @@ def test_every_robot_s_map_counts_and_maps_sent_as_changes_count_more():
     assert mapping_bytes(cosim.load_scenario("fleet50")) == 0  # mapping off
 
 
-def test_a_cell_size_whose_maps_do_not_fit_is_refused_in_one_line_with_one_that_fits():
+def test_a_cell_size_whose_maps_do_not_fit_is_refused_in_one_line_with_one_that_fits(
+    monkeypatch,
+):
+    monkeypatch.setattr("adapters.mapping.memory.available_cores", lambda: 1)  # figures below
     scenario = mapping(**{"mapping.resolution_m": 0.01})
     room = Room(2 * GIB, "MemAvailable in /proc/meminfo")
     with pytest.raises(ConfigError) as caught:
