@@ -9,6 +9,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 from assignment_bench import assignment_solve_stats
+from breakdown_bench import whole_stack_breakdown
 from dwa_bench import dwa_us_per_robot
 from humans_bench import humans_coupling
 from landmarks_bench import landmark_savings
@@ -450,6 +451,7 @@ SUITES: dict[str, Callable[[int], Result]] = {
     "cli_startup": cli_startup,
     "peers": irsim_peer,
     "threads": threads_speedup,
+    "whole_stack_breakdown": whole_stack_breakdown,
 }
 
 ON_REQUEST = {"peers"}
