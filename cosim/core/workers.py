@@ -31,6 +31,9 @@ R = TypeVar("R")
 MAX_THREADS = 64
 """The most threads a run takes (more than any machine cosim targets has cores)."""
 
+SLICES_PER_THREAD = 4
+"""Slices :meth:`Workers.chunks` cuts a batch into per thread (load balance vs overhead)."""
+
 
 class Spread(Protocol):
     """Something that runs ``fn`` over ``items`` and returns the results in order.
@@ -126,14 +129,16 @@ class Workers:
         return results
 
     def chunks(self, count: int, fn: Callable[[int, int], None], *, minimum: int = 1) -> None:
-        """Call ``fn(start, stop)`` over ``range(count)`` cut into one slice per thread.
+        """Call ``fn(start, stop)`` over ``range(count)`` cut into slices for the threads.
 
         For batch kernels that write each item's result into its own row of an output
-        array: the rows are the same whatever the cut. Fewer than ``2 * minimum`` items
-        run as one slice inline.
+        array: the rows are the same whatever the cut. The cut gives each thread
+        :data:`SLICES_PER_THREAD` slices to take in turn, so that a thread whose slice was
+        quick (robots in a narrow aisle cast short rays) takes the next one; slices hold
+        at least ``minimum`` items, and fewer than ``2 * minimum`` items run as one slice.
         """
-        parts = min(self.threads, count // max(minimum, 1))
-        if parts <= 1:
+        parts = min(self.threads * SLICES_PER_THREAD, count // max(minimum, 1))
+        if self.threads == 1 or parts <= 1:
             self.map(lambda bounds: fn(*bounds), [(0, count)])
             return
         edges = [count * k // parts for k in range(parts + 1)]
