@@ -150,11 +150,15 @@ class GlobalPlanning:
             else:
                 self.next_plan_ns[i] = now_ns + self.replan_ns
         if len(replan) > 1 and getattr(self.planner, "concurrent", False):
-            # routes of different robots at once on the run's threads; followed in order
-            started = time.perf_counter()
-            routes = run.workers.map(lambda i: self.route(i, now_ns, replan=True), replan)
-            for i, found in zip(replan, routes, strict=True):
-                self.finish(run, i, now_ns, found, started, replan=True)
+            # routes of different robots at once on the run's threads; followed in order,
+            # each plan_ms its own route's time (not the batch's)
+            def timed(i: int) -> tuple[Found, float]:
+                start = time.perf_counter()
+                return self.route(i, now_ns, replan=True), time.perf_counter() - start
+
+            routes = run.workers.map(timed, replan)
+            for i, (found, took_s) in zip(replan, routes, strict=True):
+                self.finish(run, i, now_ns, found, time.perf_counter() - took_s, replan=True)
             return
         for i in replan:
             self.plan(run, i, now_ns, replan=True)

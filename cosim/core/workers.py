@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import itertools
 import os
+import threading
 import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
@@ -59,6 +60,12 @@ def available_cores() -> int:
         return max(1, os.cpu_count() or 1)
 
 
+class _Inside(threading.local):
+    """Whether the current thread is running a batch's items (per thread)."""
+
+    active = False
+
+
 class Workers:
     """The run's threads for per-robot work within one simulated instant.
 
@@ -81,6 +88,7 @@ class Workers:
         self.threads = threads
         self._pool: ThreadPoolExecutor | None = None
         self._busy_s = [0.0] * threads
+        self._inside = _Inside()
         self.batches = 0
         """Calls of :meth:`map` that spread more than one item over more than one thread."""
 
@@ -94,6 +102,8 @@ class Workers:
         An interrupt on the calling thread (Ctrl-C, the watchdog) leaves at once.
         """
         count = len(items)
+        if self._inside.active:  # an item's own batch (a nested map): inline, no deadlock
+            return [fn(item) for item in items]
         helpers = min(self.threads, count) - 1
         if helpers <= 0:
             start = time.perf_counter()
@@ -106,17 +116,23 @@ class Workers:
         failures: list[BaseException | None] = [None] * count
         taken = itertools.count()  # next() on it is atomic: each item is taken once
 
+        inside = self._inside
+
         def drain(slot: int) -> None:
             start = time.perf_counter()
-            for k in taken:
-                if k >= count:
-                    break
-                try:
-                    results[k] = fn(items[k])
-                except Exception as error:  # raised on the run's thread, in order
-                    failures[k] = error
-                # anything else (an interrupt, a stop, the watchdog) leaves at once
-            self._busy_s[slot] += time.perf_counter() - start
+            inside.active = True
+            try:
+                for k in taken:
+                    if k >= count:
+                        break
+                    try:
+                        results[k] = fn(items[k])
+                    except Exception as error:  # raised on the run's thread, in order
+                        failures[k] = error
+                    # anything else (an interrupt, a stop, the watchdog) leaves at once
+            finally:
+                inside.active = False
+                self._busy_s[slot] += time.perf_counter() - start
 
         pool = self._executor()
         futures = [pool.submit(drain, slot) for slot in range(1, helpers + 1)]

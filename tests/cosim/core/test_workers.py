@@ -140,3 +140,15 @@ def test_an_interrupt_on_the_run_s_thread_leaves_the_batch_at_once() -> None:
             workers.map(work, list(range(200)))
     finally:
         workers.close()
+
+
+def test_an_item_that_spreads_work_of_its_own_runs_it_inline_without_waiting_for_itself() -> None:
+    workers = Workers(2)
+    try:
+        nested = workers.map(lambda i: sum(workers.map(lambda j: i * j, [1, 2, 3])), [1, 2, 3, 4])
+        again = workers.map(lambda i: i + 1, [1, 2])  # the run's thread spreads again after
+    finally:
+        workers.close()
+    assert nested == [6, 12, 18, 24]
+    assert again == [2, 3]
+    assert workers.batches == 2
