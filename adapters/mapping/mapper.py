@@ -185,7 +185,6 @@ class MappingAdapter:
             run.workers,
             self._process,
             lambda item, update: self._mapped(run, item, update),
-            Stage.SENSING,
         )
 
     # -- wiring ----------------------------------------------------------------------

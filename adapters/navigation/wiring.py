@@ -24,7 +24,6 @@ from cosim.core.adapter import RunContext
 from cosim.core.batches import InstantBatch
 from cosim.core.bus import Bus, Envelope
 from cosim.core.hosts import HostId
-from cosim.core.kernel import Stage
 from cosim.core.messages import LaserScan, Message, NavGoal, NavStatus, Path, Twist
 from cosim.core.messages import OccupancyGrid as GridMessage
 from models.arrays import FloatArray
@@ -92,8 +91,8 @@ class NavWiring:
             pose: (n, 3) every robot's pose estimate in ``map`` (m, rad), read on arrival.
             layers: every robot's static layer (its own map when robots map).
             mapping: robots build their own maps (their ``map`` topic updates ``layers``:
-                the maps of one instant are inflated together on the run's threads, and
-                used from the end of the control stage they arrived in).
+                the maps of one tick are inflated together on the run's threads as soon
+                as the tick has published them).
         """
         bus = run.bus
         costmaps: InstantBatch[tuple[int, GridMessage], StaticCostmap] = InstantBatch(
@@ -101,7 +100,6 @@ class NavWiring:
             run.workers,
             lambda item: layers.build(*item),
             lambda item, layer: layers.set(item[0], layer),
-            Stage.CONTROL,
         )
         for i, (name, host) in enumerate(zip(self.names, self.hosts, strict=True)):
             bus.subscribe(goal_topic(name), host, _on_goal(run, goals, i))

@@ -3,11 +3,13 @@
 A bus subscriber is called once per message: every robot's scan of a scan instant, every
 robot's map of a map update. Where each message starts independent per-robot work (match
 a scan against that robot's map, inflate that robot's costmap), an :class:`InstantBatch`
-keeps the messages of the instant and, at the end of the stage they arrived in, computes
-them all on the run's threads (:class:`cosim.core.workers.Workers`) and applies the
-results one by one in arrival order. What the results cause (messages, table rows) thus
-comes in the same order for any number of threads; with one thread the work is the same
-as doing it on arrival, only later within the same instant and stage.
+keeps the messages that one event hands over (one publication of every robot's scan, one
+tick's maps) and, once that event is done and before any other runs, computes them all on
+the run's threads (:class:`cosim.core.workers.Workers`) and applies the results one by one
+in arrival order. What the results cause (messages, table rows) thus comes in the same
+order for any number of threads, and nothing else in the run sees the difference from
+taking each message up on arrival: the event that delivered them does nothing with them
+after handing them over.
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Generic, TypeVar
 
-from cosim.core.kernel import Kernel, Stage
+from cosim.core.kernel import Kernel
 from cosim.core.workers import Workers
 
 T = TypeVar("T")
@@ -23,16 +25,15 @@ R = TypeVar("R")
 
 
 class InstantBatch(Generic[T, R]):
-    """Items of one instant, computed together, applied in order.
+    """Items of one event, computed together, applied in order.
 
     Args:
-        kernel: the run's kernel (the batch closes with an event at the same instant).
+        kernel: the run's kernel (the batch closes when the event that added its first
+            item is done).
         workers: the run's threads.
         compute: the per-item work; runs on any thread, so it must read only what no
             other item of the batch writes, and write only the item's own state.
         apply: takes each item and its result, in arrival order, on the kernel's thread.
-        stage: the stage in which the batch closes: the one the items arrive in, so that
-            what runs in later stages of the instant sees the results.
     """
 
     def __init__(
@@ -41,21 +42,19 @@ class InstantBatch(Generic[T, R]):
         workers: Workers,
         compute: Callable[[T], R],
         apply: Callable[[T, R], None],
-        stage: Stage,
     ) -> None:
         self.kernel = kernel
         self.workers = workers
         self.compute = compute
         self.apply = apply
-        self.stage = stage
         self._items: list[T] = []
         self.closed = 0
         """Batches closed so far."""
 
     def add(self, item: T) -> None:
-        """Keep ``item`` for this instant's batch (the first one schedules the batch's end)."""
+        """Keep ``item`` for this event's batch (the first one has the batch close after it)."""
         if not self._items:
-            self.kernel.at(self.kernel.now_ns, self._close, stage=self.stage)
+            self.kernel.after_event(self._close)
         self._items.append(item)
 
     def __len__(self) -> int:

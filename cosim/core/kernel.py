@@ -163,6 +163,7 @@ class Kernel:
         self.lateness: Lateness | None = Lateness() if realtime else None
         """Per-batch lateness of a real-time run (None when not real time)."""
         self._wall_epoch_ns = time.time_ns()
+        self._after: list[Callable[[], None]] = []
 
     @property
     def realtime(self) -> bool:
@@ -200,6 +201,22 @@ class Kernel:
         """Call ``fn()`` once at absolute time ``t_ns`` (not in the past)."""
         event = StagedTimeout(self.env, t_ns - self.now_ns, stage)
         event.callbacks.append(lambda _event: fn())
+
+    def after_event(self, fn: Callable[[], None]) -> None:
+        """Call ``fn()`` once the event being processed is done, before any other event.
+
+        What one event hands over piece by piece (a fleet's scans in one publication, every
+        robot's map in one tick) can so be taken up as a whole at the same instant, as if
+        each piece had been taken up on arrival: nothing else runs in between. Asked for
+        outside :meth:`run` (before the run starts), it is called when :meth:`run` starts.
+        """
+        self._after.append(fn)
+
+    def _flush_after(self) -> None:
+        while self._after:
+            due, self._after = self._after, []
+            for fn in due:
+                fn()
 
     def every(
         self,
@@ -263,6 +280,7 @@ class Kernel:
                 time): the run is alive (a watchdog's beat).
         """
         env = self.env
+        self._flush_after()  # asked for before the run
         if isinstance(env, simpy.rt.RealtimeEnvironment):
             if self.events_processed == 0:
                 # the wall clock starts with the run, not when the kernel was built
@@ -277,6 +295,8 @@ class Kernel:
         try:
             while peek() < until_ns:
                 step()
+                if self._after:
+                    self._flush_after()
                 processed += 1
                 if checks and processed & _HEARTBEAT_MASK == 0:
                     if heartbeat is not None:
@@ -328,6 +348,8 @@ class Kernel:
                     record.late_ns.append(late_ns)
                     batch_t, batch_events = int(t), 0
                 step()
+                if self._after:
+                    self._flush_after()
                 processed += 1
                 batch_events += 1
                 if heartbeat is not None:

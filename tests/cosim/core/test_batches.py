@@ -1,8 +1,10 @@
-"""Work of one instant kept, computed together on the run's threads, applied in order."""
+"""Work one event hands over, computed together on the run's threads, applied in order."""
 
 from __future__ import annotations
 
 import threading
+
+import pytest
 
 from cosim.core.batches import InstantBatch
 from cosim.core.kernel import Kernel, Stage
@@ -17,38 +19,46 @@ def _batch(
         workers,
         lambda item: item * 10,
         lambda item, result: log.append(("applied", item, result)),
-        Stage.SENSING,
     )
 
 
-def test_items_of_one_instant_are_applied_in_arrival_order_at_that_instant() -> None:
-    for threads in (1, 2):
-        kernel, workers = Kernel(), Workers(threads)
-        log: list[tuple[str, int, int]] = []
-        batch = _batch(kernel, workers, log)
+@pytest.mark.parametrize("threads", [1, 2])
+def test_items_of_one_event_are_applied_in_arrival_order_once_it_is_done(threads: int) -> None:
+    kernel, workers = Kernel(), Workers(threads)
+    log: list[tuple[str, int, int]] = []
+    batch = _batch(kernel, workers, log)
 
-        def arrive(now: int, batch: InstantBatch[int, int] = batch) -> None:
-            for item in (3, 1, 2):
-                batch.add(item)
+    def arrive(now: int) -> None:
+        for item in (3, 1, 2):
+            batch.add(item)
+        log.append(("handed over", now, 0))
 
-        kernel.every(1_000, arrive, stage=Stage.SENSING)
-        kernel.run(2_500)
-        workers.close()
-        # three instants (0, 1000, 2000 ns), each batch applied once, in arrival order
-        assert [entry[1:] for entry in log] == [(3, 30), (1, 10), (2, 20)] * 3
-        assert batch.closed == 3
-        assert len(batch) == 0
+    kernel.every(1_000, arrive, stage=Stage.SENSING)
+    kernel.run(2_500)
+    workers.close()
+    # three events (0, 1000, 2000 ns), each batch applied once after its event
+    one = [("applied", 3, 30), ("applied", 1, 10), ("applied", 2, 20)]
+    assert log == [
+        ("handed over", 0, 0),
+        *one,
+        ("handed over", 1000, 0),
+        *one,
+        ("handed over", 2000, 0),
+        *one,
+    ]
+    assert batch.closed == 3
+    assert len(batch) == 0
 
 
-def test_the_batch_closes_before_later_stages_of_the_same_instant() -> None:
+def test_the_batch_closes_before_any_other_event_of_the_same_instant_and_stage() -> None:
     kernel, workers = Kernel(), Workers(2)
     log: list[tuple[str, int, int]] = []
     batch = _batch(kernel, workers, log)
-    kernel.at(500, lambda: batch.add(7), stage=Stage.SENSING)
-    kernel.at(500, lambda: log.append(("control", kernel.now_ns, 0)), stage=Stage.CONTROL)
+    kernel.at(500, lambda: batch.add(7), stage=Stage.CONTROL)
+    kernel.at(500, lambda: log.append(("next event", kernel.now_ns, 0)), stage=Stage.CONTROL)
     kernel.run(1_000)
     workers.close()
-    assert log == [("applied", 7, 70), ("control", 500, 0)]
+    assert log == [("applied", 7, 70), ("next event", 500, 0)]
 
 
 def test_compute_may_run_on_another_thread_and_apply_runs_on_the_kernels() -> None:
@@ -60,7 +70,6 @@ def test_compute_may_run_on_another_thread_and_apply_runs_on_the_kernels() -> No
         workers,
         lambda item: (barrier.wait(), threading.get_ident())[1],
         lambda item, ident: applied_on.append(threading.get_ident()),
-        Stage.CONTROL,
     )
     kernel.at(0, lambda: [batch.add(i) for i in range(2)] and None, stage=Stage.CONTROL)
     kernel.run(1)

@@ -190,3 +190,20 @@ def test_wall_and_simulated_clocks_map_onto_each_other_at_the_kernel_speed():
     wall = kernel.wall_ns(4_000_000_000)
     assert kernel.sim_ns(wall) == 4_000_000_000
     assert kernel.wall_ns(4_000_000_000) - kernel.wall_ns(0) == 2_000_000_000
+
+
+@pytest.mark.parametrize("realtime", [False, True])
+def test_after_event_runs_once_the_event_is_done_before_any_other(realtime):
+    kernel = Kernel(realtime=True, speed=1e6) if realtime else Kernel()
+    log = []
+
+    def first():
+        kernel.after_event(lambda: log.append("after first"))
+        kernel.after_event(lambda: kernel.after_event(lambda: log.append("after after")))
+        log.append("first")
+
+    kernel.after_event(lambda: log.append("asked before the run"))
+    kernel.at(10, first, stage=Stage.CONTROL)
+    kernel.at(10, lambda: log.append("second"), stage=Stage.CONTROL)
+    kernel.run(100)
+    assert log == ["asked before the run", "first", "after first", "after after", "second"]
