@@ -135,7 +135,14 @@ def test_any_older_runs_scenario_reads_and_dumps_back_or_is_refused_in_one_line(
         _one_line(note, str(path))
     again = tmp_path / "again.toml"
     again.write_text(dump_scenario(scenario), encoding="utf-8", errors="surrogatepass")
-    assert cosim.load_scenario(again, reading=True) == scenario
+    reloaded = cosim.load_scenario(again, reading=True)
+    if reloaded != scenario:
+        # only a NaN (carried from an unknown section of an older run) may differ, as no NaN
+        # equals itself: the file read back must then dump to itself
+        assert "nan" in dump_scenario(scenario)
+        dumped = dump_scenario(reloaded)
+        again.write_text(dumped, encoding="utf-8", errors="surrogatepass")
+        assert dump_scenario(cosim.load_scenario(again, reading=True)) == dumped
 
 
 @settings(
