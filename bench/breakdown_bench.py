@@ -18,6 +18,8 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import Any
 
+from cases import FULL_STACK
+
 import cosim
 from adapters.assignment.dta import DtaAdapter
 from adapters.fleet.motion import FleetAdapter
@@ -81,8 +83,6 @@ def _timers(spent: collections.Counter[str]) -> Iterator[None]:
 
 def whole_stack_breakdown(repeat: int) -> Result:
     """Seconds and shares of the run's wall time per component, whole stack, 1 and 2 threads."""
-    from suites import FULL_STACK
-
     scenario = cosim.load_scenario("fleet50", FULL_STACK)
     for threads in (1, 2):
         cosim.run(scenario, duration_s=1.0, threads=threads)  # caches warm

@@ -18,6 +18,8 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
+from cases import FULL_STACK
+
 import cosim
 from adapters.world.warehouse import scenario_warehouse
 
@@ -80,7 +82,7 @@ def irsim_peer(repeat: int) -> Result:
     cosim's cases run on every core (``threads`` = the cores available, as ``cosim run``
     does), the whole stack also on one thread.
     """
-    from suites import FULL_STACK, SineDriver
+    from suites import SineDriver
 
     base = cosim.load_scenario("fleet50")
     whole = cosim.load_scenario("fleet50", FULL_STACK)

@@ -10,6 +10,7 @@ from typing import Any, ClassVar
 import numpy as np
 from assignment_bench import assignment_solve_stats
 from breakdown_bench import whole_stack_breakdown
+from cases import EVERY_ROBOT_PLANS, FULL_STACK
 from dwa_bench import dwa_us_per_robot
 from humans_bench import humans_coupling
 from landmarks_bench import landmark_savings
@@ -271,11 +272,6 @@ def _shares(scenario: cosim.Scenario, breakdown: dict[str, tuple[str, str]]) -> 
     return {"summary": result.summary, "shares": shares}
 
 
-EVERY_ROBOT_PLANS = {"navigation.traffic": "none"}
-"""fleet50's robots each planning with A* and following with DWA (the paper's Nav2 role), not
-moved by the preset's fleet manager: what the navigation figures and breakdowns measure."""
-
-
 def fleet50_navigation(repeat: int) -> Result:
     """fleet50, every robot planning (A* + DWA) to random goals: real-time factor, where time
     goes; and the preset as it comes (its fleet manager, traffic 'pibt') in the same run."""
@@ -293,19 +289,6 @@ def fleet50_navigation(repeat: int) -> Result:
         "breakdown_note": "cProfile shares of a 30 s run (profiling slows the run ~30 %)",
     }
 
-
-FULL_STACK = {
-    **EVERY_ROBOT_PLANS,
-    "robots.driver": "tasks",
-    "tasks.initial": 50,
-    "assignment.protocol": "distributed_simplex",
-    "mapping.enabled": True,
-    "odometry.drift": 0.02,
-}
-"""fleet50 with the whole stack: 50 tasks assigned by distributed simplex (a new one for each
-done), every robot mapping as it drives on drifting odometry, navigation on its own map
-(every robot planning: the preset's fleet manager refuses robots localizing on their own
-maps)."""
 
 FULL_STACK_BREAKDOWN = {
     "task assignment rounds (protocol, broadcasts)": ("adapters/assignment/dta.py", "_round_of"),

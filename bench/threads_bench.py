@@ -15,18 +15,12 @@ import subprocess
 import sys
 from typing import Any
 
+from cases import FULL_STACK
+
 Result = dict[str, Any]
 
-WHOLE_STACK = {
-    "navigation.traffic": "none",
-    "robots.driver": "tasks",
-    "tasks.initial": 50,
-    "assignment.protocol": "distributed_simplex",
-    "mapping.enabled": True,
-    "odometry.drift": 0.02,
-}
 CASES: dict[str, tuple[dict[str, Any], float]] = {
-    "fleet50_whole_stack": (WHOLE_STACK, 30.0),
+    "fleet50_whole_stack": (FULL_STACK, 30.0),
     "fleet50_preset": ({}, 30.0),
     "fleet1000_pibt": (
         {"robots.count": 1000, "world.size_m": [100.0, 100.0], "world.shelf_count": 600},
