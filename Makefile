@@ -12,7 +12,7 @@ STUDY = $(BIN)/cosim study studies/$(1).toml --out $(STUDIES)/$(1) --resume
 
 .PHONY: setup demo test test-fast docs lint bench bench-peers clean help reproduce study-comm study-comm-reduced \
 	study-burst study-scale study-paper study-nav study-mapping study-mapping-reduced \
-	study-mapping-acceptance study-mapping-drift map-aces map-fr079 \
+	study-mapping-acceptance study-mapping-defaults study-mapping-drift map-aces map-fr079 \
 	lab-real lab-mixed study-humans study-humans-reduced study-humans-contacts study-traffic
 
 help:  ## list the targets
@@ -103,6 +103,9 @@ study-mapping-reduced: setup  ## map sharing reduced to 12 runs x 120 s
 study-mapping-acceptance: setup  ## the warehouse mapping acceptance: 10 seeds x 300 s, matching vs odometry (about 3 min)
 	$(call STUDY,mapping_acceptance)
 
+study-mapping-defaults: setup  ## warehouse-random with only mapping on and drift 0.02, 10 seeds x 120 s, robots layer auto vs off (under 1 min)
+	$(call STUDY,mapping_defaults)
+
 study-traffic: setup  ## traffic policies 'none', 'lanes', 'pibt' x 25/50 robots, 10 seeds x 300 s (about 7 min)
 	$(call STUDY,traffic)
 
@@ -120,8 +123,8 @@ FR079 ?= ../shared/data/fr079_lidar
 map-aces: setup  ## map the ACES building's recording (needs ../shared/data) into runs/aces
 	$(BIN)/cosim map $(ACES) --out runs/aces --reference /ground_truth --force
 
-study-mapping-drift: setup  ## mapping on 30 drift realizations of each shared building, with and without loop closure (about 6 min)
-	$(BIN)/python studies/mapping_drift.py --seeds 30 --workers 2
+study-mapping-drift: setup  ## mapping on 10 drift realizations of each shared building, as recorded and cut to a 10 m lidar, with and without loop closure (about 3 min)
+	$(BIN)/python studies/mapping_drift.py --seeds 10 --workers 2
 
 map-fr079: setup  ## map Freiburg building 079's recording (needs ../shared/data) into runs/fr079
 	$(BIN)/cosim map $(FR079) --out runs/fr079 --reference /ground_truth --force

@@ -141,7 +141,7 @@ def build_parts(run: RunContext) -> NavigationParts:
     memory = _scan_memory(run, n)
     moving = MovingMemory(s_to_ns(cfg.obstacle_memory_s), layers.resolution_m)
     paths = PathBook(n)
-    robots_layer = _robots_layer(run, cfg, names, hosts, radius)
+    robots_layer = _robots_layer(run, cfg, names, hosts, radius, mapping=mapping)
     records = NavRecords(run.recorder, names)
     rngs = [run.rng.stream(f"navigation/{name}") for name in names]
     control = controller_registry().get(cfg.controller)(
@@ -236,10 +236,16 @@ def _scan_memory(run: RunContext, robots: int) -> ScanMemory:
 
 
 def _robots_layer(
-    run: RunContext, cfg: NavigationConfig, names: list[str], hosts: list[HostId], radius: float
+    run: RunContext,
+    cfg: NavigationConfig,
+    names: list[str],
+    hosts: list[HostId],
+    radius: float,
+    *,
+    mapping: bool,
 ) -> RobotsLayer | None:
-    """The robots layer, offered to the run, with ``navigation.robots_layer``; else None."""
-    if not cfg.robots_layer:
+    """The robots layer, offered to the run, when ``navigation.robots_layer`` is on; else None."""
+    if not cfg.robots_layer_on(mapping):
         return None
     robots_layer = RobotsLayer(names, hosts, radius, cfg.robots_layer_timeout_s)
     run.provide(robots_layer)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import ClassVar, Literal
 
 from cosim.scenario.fields import param
 
@@ -32,8 +32,10 @@ class NavigationConfig:
     )
     replan_hz: float = param(1.0, "periodic global replanning rate (Hz)", gt=0, le=50)
     control_hz: float = param(10.0, "local controller rate (Hz)", gt=0, le=100)
-    robots_layer: bool = param(
-        False, "robots broadcast pose and footprint over the network; others avoid them"
+    robots_layer: bool | Literal["auto"] = param(
+        "auto",
+        "robots broadcast pose and footprint over the network; others avoid them and their "
+        "mappers leave them out of the map; auto: on whenever mapping.enabled",
     )
     robots_layer_hz: float = param(5.0, "robots layer broadcast rate (Hz)", gt=0, le=1000)
     robots_layer_timeout_s: float = param(1.0, "forget a robot not heard from for (s)", gt=0)
@@ -65,3 +67,13 @@ class NavigationConfig:
         "and round again (robot i starts at goal i); empty: random reachable goals",
         unit="m",
     )
+
+    def robots_layer_on(self, mapping: bool) -> bool:
+        """Whether the robots layer runs, in a run where ``mapping.enabled`` is ``mapping``.
+
+        ``auto`` turns it on with mapping: robots are not the building, and a mapper that
+        does not know where the others are draws them into its map as walls (in
+        ``warehouse-random``, 10 seeds x 180 s at drift 0.02, fleet map IoU 0.85-1.00 with it,
+        0.77-0.95 without).
+        """
+        return mapping if self.robots_layer == "auto" else bool(self.robots_layer)

@@ -78,6 +78,7 @@ LABELS: Mapping[str, str] = MappingProxyType(
         "mapping.scan_matching": "Scan matching",
         "robots.count": "Robots",
         "navigation.traffic": "Traffic planner",
+        "navigation.robots_layer": "Robots layer (others' footprints)",
         "world.layout": "Shelf layout",
     }
 )

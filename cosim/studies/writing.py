@@ -136,10 +136,38 @@ def collect(spec: StudySpec, out: Path) -> pd.DataFrame:
 def write_results(frame: pd.DataFrame, path: Path) -> None:
     """Write a study's results beside ``path``, then rename: a full disk keeps the old file.
 
+    A column whose runs hold values of different kinds (a grid over ``"auto"`` and
+    ``false``) is written as text, each value as TOML spells it (``auto``, ``false``): a
+    Parquet column has one type.
+
     Raises:
         ExportError: the results cannot be written (read-only, full).
     """
+    frame = uniform_columns(frame)
     try:
         replace_file(path, lambda beside: frame.to_parquet(beside, index=False))
     except OSError as error:
         raise ExportError(f"{path}: cannot write the results ({_reason(error)})") from None
+
+
+def uniform_columns(frame: pd.DataFrame) -> pd.DataFrame:
+    """``frame`` with each column of values of several kinds turned into their TOML text.
+
+    Missing values stay missing; a column of one kind is left as it is.
+    """
+    mixed = {}
+    for name in frame.columns:
+        column = frame[name]
+        if column.dtype != object:
+            continue
+        kinds = {type(v) for v in column.dropna()}
+        if len(kinds) > 1:
+            mixed[name] = column.map(_toml_text, na_action="ignore")
+    return frame.assign(**mixed) if mixed else frame
+
+
+def _toml_text(value: Any) -> str:
+    """A value as a scenario file spells it: ``true``, ``0.5``, a string as it is."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    return value if isinstance(value, str) else json.dumps(value, default=str)

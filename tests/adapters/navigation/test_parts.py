@@ -62,6 +62,13 @@ def test_the_static_costmap_is_offered_to_the_run_and_the_robots_layer_only_when
     assert parts.robots_layer is not None and run.service(RobotsLayer) is parts.robots_layer
 
 
+def test_robots_that_map_get_the_robots_layer_unless_it_is_turned_off():
+    run, parts = _parts(**{"mapping.enabled": True})
+    assert parts.robots_layer is not None and run.service(RobotsLayer) is parts.robots_layer
+    run, parts = _parts(**{"mapping.enabled": True, "navigation.robots_layer": False})
+    assert parts.robots_layer is None and not run.has_service(RobotsLayer)
+
+
 def test_each_robots_topics_are_advertised_robot_by_robot_and_the_robots_layer_after_them():
     run, parts = _parts(**{"navigation.robots_layer": True})
     advertised = list(run.bus.advertised())

@@ -22,7 +22,20 @@ def test_the_defaults_are_nav2s_where_it_has_one():
     assert (cfg.replan_hz, cfg.control_hz, cfg.goal_tolerance_m) == (1.0, 10.0, 0.25)
     assert (cfg.inflation_radius_m, cfg.cost_scaling, cfg.resolution_m) == (1.0, 3.0, 0.1)
     assert (cfg.stuck_timeout_s, cfg.progress_hz, cfg.obstacle_memory_s) == (30.0, 1.0, 3.0)
-    assert not cfg.robots_layer and cfg.goals == ()
+    assert cfg.robots_layer == "auto" and cfg.goals == ()
+
+
+@pytest.mark.parametrize(
+    ("value", "mapping", "on"),
+    [("auto", False, False), ("auto", True, True), (True, False, True), (False, True, False)],
+)
+def test_the_robots_layer_is_on_with_mapping_unless_set_either_way(value, mapping, on):
+    assert _navigation(robots_layer=value).robots_layer_on(mapping) is on
+
+
+def test_a_robots_layer_neither_true_false_nor_auto_is_refused_naming_what_is_expected():
+    with pytest.raises(ConfigError, match=r"robots_layer = 'sometimes'.*true or false or.*'auto'"):
+        _navigation(robots_layer="sometimes")
 
 
 def test_goals_are_read_as_pairs_in_map():

@@ -93,3 +93,22 @@ def test_preparing_clears_only_runs_cut_short_on_their_way(tmp_path):
     prepare(tmp_path, FolderState(frozenset(), (), "{}"))
     assert not stale.exists()
     assert {path: path.read_text() for path in mine} == mine
+
+
+def test_a_grid_over_values_of_two_kinds_is_written_as_their_toml_text(tmp_path):
+    # a study over navigation.robots_layer = ["auto", false]: Parquet holds one type per column
+    frame = pd.DataFrame(
+        {"navigation.robots_layer": ["auto", False, None], "seed": [1, 2, 3], "x": [0.5, 1, 2]}
+    )
+    write_results(frame, tmp_path / "results.parquet")
+    back = pd.read_parquet(tmp_path / "results.parquet")
+    layer = back["navigation.robots_layer"]
+    assert layer[:2].tolist() == ["auto", "false"] and layer.isna()[2]
+    assert back["seed"].tolist() == [1, 2, 3] and back["x"].tolist() == [0.5, 1.0, 2.0]
+
+
+def test_a_column_of_one_kind_is_written_as_it_is(tmp_path):
+    frame = pd.DataFrame({"navigation.robots_layer": [True, False], "name": ["a", "b"]})
+    write_results(frame, tmp_path / "results.parquet")
+    back = pd.read_parquet(tmp_path / "results.parquet")
+    assert back["navigation.robots_layer"].tolist() == [True, False]
