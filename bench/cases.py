@@ -19,4 +19,8 @@ FULL_STACK: dict[str, Any] = {
 """fleet50 with the whole stack: 50 tasks assigned by distributed simplex (a new one for each
 done), every robot mapping as it drives on drifting odometry, navigation on its own map
 (every robot planning: the preset's fleet manager refuses robots localizing on their own
-maps)."""
+maps), and the robots layer that mapping turns on (``navigation.robots_layer = "auto"``:
+each robot broadcasts its pose, each mapper leaves the others out of its map). Since that
+default (after 384ef66) the case maps better (fleet map IoU 0.886 against 0.615 at 30 s,
+seed 5) and runs about a quarter slower (5.0-5.3x real time against 6.4-6.9x on 2 threads,
+measured 2026-11-28) than the figures measured before it."""

@@ -65,11 +65,10 @@ def test_navigation_plans_on_each_robots_own_map_and_localizes_by_its_estimate(m
 
 @pytest.mark.slow
 def test_sharing_under_total_loss_degrades_to_each_robots_own_map(tmp_path):
-    alone = _run(tmp_path / "alone")
-    lost = _run(
-        tmp_path / "lost",
-        **{"mapping.share": "scans", "network.loss_model": "bernoulli", "network.loss_prob": 1.0},
-    )
+    # both under total loss: the robots layer's poses (on with mapping) are lost too
+    total_loss = {"network.loss_model": "bernoulli", "network.loss_prob": 1.0}
+    alone = _run(tmp_path / "alone", **total_loss)
+    lost = _run(tmp_path / "lost", **{"mapping.share": "scans", **total_loss})
     assert lost.summary["map_merges"] == 0 and lost.summary["map_share_messages"] > 0
     for name in ("robot_1", "robot_2", "robot_3"):
         assert np.array_equal(
