@@ -218,7 +218,8 @@ def map_scans(
         raise ValueError(f"the odometry {too_large}")
     lo, hi = poses[:, :2].min(axis=0), poses[:, :2].max(axis=0)
     geometry = MapGeometry.covering((lo[0], lo[1], hi[0], hi[1]), resolution_m, reach)
-    grid = LogOddsMap(geometry)
+    matcher = matcher or MatcherParams()
+    grid = LogOddsMap(geometry, hit_centroids=matcher.refine_against == "walls")
     # readings at the maximum are no return (REP 117, and CARMEN logs' clip value)
     limit_m = range_max_m * 0.999
     far_m = 2.0 * math.hypot(geometry.width, geometry.height) * resolution_m
@@ -227,7 +228,7 @@ def map_scans(
     loops = LoopParams() if loop_closure is True else (loop_closure or None)
     params = MapperParams(
         gate=gate or UpdateGate(),
-        matcher=matcher or MatcherParams(),
+        matcher=matcher,
         scan_matching=scan_matching,
         range_min_m=range_min_m,
         range_max_m=limit_m,

@@ -78,6 +78,7 @@ def mapper_params(cfg: MappingConfig, lidar_min_m: float, lidar_max_m: float) ->
             window_m=cfg.search_window_m,
             window_rad=cfg.search_window_rad,
             margin=cfg.match_margin,
+            refine_against=cfg.refine,
         ),
         scan_matching=cfg.scan_matching != "none",
         range_min_m=lidar_min_m,
@@ -147,7 +148,13 @@ class MappingAdapter:
         sharing = MAP_SHARING.installed().get(self.cfg.share)
         track = sharing.tracks_changes
         self.maps = [
-            LogOddsMap(self.geometry, scratch=scratch, track_changes=track) for _ in self.names
+            LogOddsMap(
+                self.geometry,
+                scratch=scratch,
+                track_changes=track,
+                hit_centroids=self.cfg.refine == "walls",
+            )
+            for _ in self.names
         ]
         self.params = mapper_params(self.cfg, lidar.range_min_m, lidar.range_max_m)
         self.mappers = [

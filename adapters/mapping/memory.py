@@ -13,7 +13,9 @@ Bytes per cell, as :mod:`models.mapping.grid` and the adapter allocate them:
 - each robot: log-odds (float32, 4), fine and coarse matching scores (uint8, 1 + 1), the
   map rendered for ``/robot_i/map`` and kept latched on the bus (int8, 1 + 1) and the final
   map the run keeps (int8, 1): 9; with a sharing mode that tracks changes
-  (``share = "maps"``), the log-odds not yet sent (float32, 4) more;
+  (``share = "maps"``), the log-odds not yet sent (float32, 4) more; refining on walls
+  (``refine = "walls"``), where its returns fell in each cell (uint8 mean offsets x, y
+  and a uint8 count: 3) more;
 - shared: the update's scratch (int32 stamp, uint8 dirty flag: 5), the fleet map and the
   ground truth the map quality is measured against, with its masks (about 11): 16;
 - each thread of the run that maps (``--threads``, at most the cores available): its own
@@ -38,6 +40,8 @@ ROBOT_BYTES_PER_CELL = 9
 """Each robot's map, matching scores and rendered copies (bytes per cell)."""
 CHANGES_BYTES_PER_CELL = 4
 """Each robot's unsent log-odds, with a sharing mode that tracks changes (bytes per cell)."""
+CENTROID_BYTES_PER_CELL = 3
+"""Each robot's hit sums and counts, when scan matching refines on walls (bytes per cell)."""
 SHARED_BYTES_PER_CELL = 16
 """The scratch, fleet map and ground truth every robot's map shares (bytes per cell)."""
 THREAD_BYTES_PER_CELL = 5
@@ -59,6 +63,8 @@ def mapping_bytes(scenario: Scenario, resolution_m: float | None = None) -> int:
     per_robot = ROBOT_BYTES_PER_CELL
     if MAP_SHARING.installed().get(cfg.share).tracks_changes:
         per_robot += CHANGES_BYTES_PER_CELL
+    if cfg.refine == "walls":
+        per_robot += CENTROID_BYTES_PER_CELL
     robots = scenario.section(RobotsConfig).count
     # a run takes the cores available unless told fewer threads: count a scratch for each
     threads = THREAD_BYTES_PER_CELL * min(available_cores(), MAX_THREADS)

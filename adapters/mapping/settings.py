@@ -64,6 +64,14 @@ class MappingConfig:
         le=1,
         unit="score (0..1)",
     )
+    refine: Literal["walls", "score"] = param(
+        "walls",
+        "scan matching: what the last, sub-cell step fits: 'walls', each return onto the wall "
+        "it lies near (fitted to where returns fell in their cells), or 'score', the "
+        "bilinear match score (cosim map's default on real recordings). On the simulated "
+        "warehouse (warehouse-mapping, 10 seeds x 300 s) 'walls' gave fleet map IoU "
+        "0.94-1.00 where 'score' gave 0.88-1.00 (see the mapping guide)",
+    )
     map_update_interval_s: float = param(
         5.0, "period of each robot's map going to its navigation and the bag (s)", gt=0
     )

@@ -32,7 +32,14 @@ import numpy.typing as npt
 from models.arrays import FloatArray
 from models.errors import ModelError
 from models.geometry.occupancy import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
-from models.mapping.kernels import apply, classify, rebuild_scores, refresh_scores, traverse
+from models.mapping.kernels import (
+    accumulate_hits,
+    apply,
+    classify,
+    rebuild_scores,
+    refresh_scores,
+    traverse,
+)
 
 COARSE = 4
 """Cells per side of the coarse score's window (the matcher's first level)."""
@@ -148,6 +155,7 @@ class LogOddsMap:
         *,
         scratch: Scratch | None = None,
         track_changes: bool = False,
+        hit_centroids: bool = False,
     ) -> None:
         self.geometry = geometry
         self.params = params or LogOddsParams()
@@ -159,6 +167,13 @@ class LogOddsMap:
         self.changes = np.zeros(shape if track_changes else (0, 0), dtype=np.float32)
         """With ``track_changes``: the log-odds this map's own scans added since
         :meth:`take_changes` (what a robot has not yet told its neighbours)."""
+        h, w = shape if hit_centroids else (0, 0)
+        self.hit_means = np.zeros((h, w, 2), dtype=np.uint8)
+        """With ``hit_centroids``: per cell, the mean offset of its returns from its
+        lower-left corner, in 255ths of a cell each way: where its surface lies within it
+        (what :func:`models.mapping.walls.refine_on_walls` fits walls to)."""
+        self.hit_counts = np.zeros((h, w), dtype=np.uint8)
+        """With ``hit_centroids``: the returns each cell's mean holds (at most 255)."""
         self.occupied_cells = 0
         r = math.ceil(SCORE_REACH * self.params.score_sigma_cells)
         off = np.arange(-r, r + 1)
@@ -232,7 +247,28 @@ class LogOddsMap:
             cells,
             hits,
         )
-        return self._apply(cells, hits, n)
+        flipped = self._apply(cells, hits, n)
+        if self.hit_counts.size:
+            accumulate_hits(
+                self.hit_means,
+                self.hit_counts,
+                g.origin_xy_m[0],
+                g.origin_xy_m[1],
+                g.resolution_m,
+                float(pose[0]),
+                float(pose[1]),
+                float(pose[2]),
+                np.ascontiguousarray(angles_rad, dtype=np.float64),
+                ranges,
+                range_min_m,
+                range_max_m,
+            )
+        return flipped
+
+    @property
+    def has_hit_centroids(self) -> bool:
+        """Whether this map keeps where in each cell its returns fell (``hit_centroids``)."""
+        return self.hit_counts.size > 0
 
     def fit(self, pose: tuple[float, float, float], points: FloatArray) -> float:
         """How well ``points`` (sensor frame, m) at ``pose`` lie on the map: mean fine score, 0-1.
@@ -324,6 +360,8 @@ class LogOddsMap:
         self.occupied_cells = 0
         if self.changes.size:
             self.changes[:] = 0.0
+        self.hit_means[:] = 0
+        self.hit_counts[:] = 0
 
     def take_changes(self) -> npt.NDArray[np.float32] | None:
         """The own evidence added since the last call, and start collecting afresh.

@@ -140,7 +140,10 @@ class LoopSearch:
         reach = min(self.limits[1], self.params.matcher.max_range_m)
         lo = poses[nodes, :2].min(axis=0) - reach
         hi = poses[nodes, :2].max(axis=0) + reach
-        local = LogOddsMap(MapGeometry.covering((lo[0], lo[1], hi[0], hi[1]), r, 1.0))
+        local = LogOddsMap(
+            MapGeometry.covering((lo[0], lo[1], hi[0], hi[1]), r, 1.0),
+            hit_centroids=self.params.matcher.refine_against == "walls",
+        )
         for j in nodes:
             self._integrate(local, tuple(poses[j]), self.updates.nodes[j].ranges)
         return local

@@ -5,6 +5,7 @@ import pytest
 import cosim
 from adapters.mapping.geometry import map_geometry
 from adapters.mapping.memory import (
+    CENTROID_BYTES_PER_CELL,
     CHANGES_BYTES_PER_CELL,
     ROBOT_BYTES_PER_CELL,
     SHARED_BYTES_PER_CELL,
@@ -38,8 +39,11 @@ def test_every_robot_s_map_counts_and_maps_sent_as_changes_count_more():
     # each thread a run may take (the cores available) has a scratch of its own
     threads = THREAD_BYTES_PER_CELL * available_cores()
     shared = cols * rows * (SHARED_BYTES_PER_CELL + threads)
-    assert mapping_bytes(mapping()) == cols * rows * 50 * ROBOT_BYTES_PER_CELL + shared
-    sent = mapping(**{"mapping.share": "maps"})
+    walls = ROBOT_BYTES_PER_CELL + CENTROID_BYTES_PER_CELL  # the default refine keeps returns
+    assert mapping_bytes(mapping()) == cols * rows * 50 * walls + shared
+    on_score = mapping(**{"mapping.refine": "score"})
+    assert mapping_bytes(on_score) == cols * rows * 50 * ROBOT_BYTES_PER_CELL + shared
+    sent = mapping(**{"mapping.share": "maps", "mapping.refine": "score"})
     per_robot = ROBOT_BYTES_PER_CELL + CHANGES_BYTES_PER_CELL
     assert mapping_bytes(sent) == cols * rows * 50 * per_robot + shared
     assert mapping_bytes(cosim.load_scenario("fleet50")) == 0  # mapping off
@@ -55,12 +59,12 @@ def test_a_cell_size_whose_maps_do_not_fit_is_refused_in_one_line_with_one_that_
         check_mapping_memory(scenario, room)
     assert str(caught.value) == (
         "preset fleet50: [mapping] resolution_m = 0.01: expected a cell size of at least "
-        "0.016 m on this machine: 50 robots' maps of 3,240 x 3,240 cells would take about "
-        "4.6 GiB, more than the 2.0 GiB of memory this process has left (MemAvailable in "
+        "0.018 m on this machine: 50 robots' maps of 3,240 x 3,240 cells would take about "
+        "6.1 GiB, more than the 2.0 GiB of memory this process has left (MemAvailable in "
         "/proc/meminfo)"
     )
-    assert mapping_bytes(scenario, 0.016) <= room.bytes < mapping_bytes(scenario, 0.015)
-    check_mapping_memory(mapping(**{"mapping.resolution_m": 0.016}), room)
+    assert mapping_bytes(scenario, 0.018) <= room.bytes < mapping_bytes(scenario, 0.017)
+    check_mapping_memory(mapping(**{"mapping.resolution_m": 0.018}), room)
 
 
 def test_the_default_cell_size_of_fifty_robots_passes_in_a_gigabyte():

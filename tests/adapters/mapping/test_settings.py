@@ -3,6 +3,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import cosim
+from adapters.mapping.mapper import mapper_params
 from adapters.mapping.settings import NO_SHARING, MappingConfig
 from cosim.core.errors import ConfigError
 from cosim.runner.assembly import adapter_names
@@ -25,6 +26,13 @@ def test_mapping_is_off_by_default_with_slam_toolboxs_defaults():
     )
     assert cfg.map_update_interval_s == 5.0 and cfg.scan_matching == "correlative"
     assert cfg.loop_closure is False
+    assert cfg.refine == "walls"  # not slam_toolbox's: measured on the simulated warehouse
+
+
+@pytest.mark.parametrize("refine", ["walls", "score"])
+def test_each_refine_reaches_the_robots_matcher(refine):
+    cfg = scenario(**{"mapping.enabled": True, "mapping.refine": refine}).section(MappingConfig)
+    assert mapper_params(cfg, 0.1, 10.0).matcher.refine_against == refine
 
 
 def test_robots_map_only_when_mapping_is_enabled():

@@ -203,3 +203,22 @@ def test_cells_cleared_next_to_equal_obstacles_leave_the_scores_rebuilt_from_scr
     assert np.array_equal(grid.score, score)
     assert np.array_equal(grid.coarse, coarse)
     assert grid.occupied_cells == count == 3 - len(cleared)
+
+
+def test_a_map_that_keeps_its_returns_knows_where_in_a_cell_a_wall_lies():
+    # a wall at x = 1.013 m, 13 mm into cell 20 of 5 cm cells: every return falls there
+    geometry = MapGeometry((0.0, 0.0), 0.05, 40, 40)
+    grid = LogOddsMap(geometry, hit_centroids=True)
+    assert grid.has_hit_centroids and not LogOddsMap(geometry).has_hit_centroids
+    angles = np.linspace(-0.3, 0.3, 31)
+    ranges = (1.013 - 0.5) / np.cos(angles)
+    grid.integrate(
+        (0.5, 1.0, 0.0), angles, ranges, range_min_m=0.1, range_max_m=5.0, clear_no_return_m=1.0
+    )
+    cells = grid.hit_counts > 0
+    columns = np.flatnonzero(cells.any(axis=0))
+    assert columns.tolist() == [20] and grid.hit_counts.sum() == len(angles)
+    within = grid.hit_means[cells][:, 0] / 255.0
+    assert np.allclose(within, 0.26, atol=0.5 / 255)  # 13 mm of a 5 cm cell
+    grid.clear()
+    assert not grid.hit_counts.any() and not grid.hit_means.any()
