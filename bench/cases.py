@@ -20,7 +20,8 @@ FULL_STACK: dict[str, Any] = {
 done), every robot mapping as it drives on drifting odometry, navigation on its own map
 (every robot planning: the preset's fleet manager refuses robots localizing on their own
 maps), and the robots layer that mapping turns on (``navigation.robots_layer = "auto"``:
-each robot broadcasts its pose, each mapper leaves the others out of its map). Since that
-default (after 384ef66) the case maps better (fleet map IoU 0.886 against 0.615 at 30 s,
-seed 5) and runs about a quarter slower (5.0-5.3x real time against 6.4-6.9x on 2 threads,
-measured 2026-11-28) than the figures measured before it."""
+each robot broadcasts its pose, each mapper leaves the others out of its map) and the
+refine on walls (``mapping.refine = "walls"``). Since those defaults (after 384ef66) the
+case maps better (fleet map IoU 0.964 against 0.615 at 30 s, seed 5) and runs about a third
+slower (4.5-4.7x real time against 6.4-6.9x on 2 threads, measured 2026-11-28) than the
+figures measured before them."""
