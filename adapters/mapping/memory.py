@@ -41,7 +41,7 @@ ROBOT_BYTES_PER_CELL = 9
 CHANGES_BYTES_PER_CELL = 4
 """Each robot's unsent log-odds, with a sharing mode that tracks changes (bytes per cell)."""
 CENTROID_BYTES_PER_CELL = 3
-"""Each robot's hit sums and counts, when scan matching refines on walls (bytes per cell)."""
+"""Each robot's hit means and counts, when scan matching refines on walls (bytes per cell)."""
 SHARED_BYTES_PER_CELL = 16
 """The scratch, fleet map and ground truth every robot's map shares (bytes per cell)."""
 THREAD_BYTES_PER_CELL = 5
