@@ -324,6 +324,14 @@ def build_parser() -> argparse.ArgumentParser:
         "(default 0: corrections of noisy real odometry matter; runs use 0.02)",
     )
     mapping.add_argument(
+        "--refine",
+        choices=("score", "walls"),
+        default="score",
+        help="what the matcher's sub-cell step fits: the match score (default, robust on "
+        "real recordings) or the walls fitted to where returns fell (runs' default: exact on "
+        "simulated walls, worse on rough real ones)",
+    )
+    mapping.add_argument(
         "--no-loop-closure",
         action="store_true",
         help="do not close loops (scan-to-map matching only, as the robots in a run do)",

@@ -328,7 +328,7 @@ def _cmd_map(args: argparse.Namespace) -> int:
             reference_topic=args.reference,
             resolution_m=args.resolution_m,
             gate=UpdateGate(min_travel_m=args.min_travel_m),
-            matcher=MatcherParams(margin=args.match_margin),
+            matcher=MatcherParams(margin=args.match_margin, refine_against=args.refine),
             scan_matching=args.scan_matching != "none",
             loop_closure=not args.no_loop_closure,
             force=args.force,

@@ -347,6 +347,21 @@ def test_nan_inf_and_negative_ranges_and_a_lidar_without_maximum_map_with_exit_0
         assert summary["scans"] == 12 and summary["ate_m"] < 0.05
 
 
+@pytest.mark.parametrize("refine", ["score", "walls"])
+def test_either_refine_maps_a_drive_and_an_unknown_one_is_refused_in_one_line(tmp_path, refine):
+    bag = write(tmp_path / "bag", drive())
+    out = tmp_path / refine
+    done = _cli(
+        "map", str(bag), "--out", str(out), "--quiet", "--reference", "/ground_truth",
+        "--refine", refine,
+    )  # fmt: skip
+    assert done.returncode == 0 and done.stderr == "", done.stderr
+    assert json.loads((out / "summary.json").read_text())["ate_m"] < 0.05
+    refused = _cli("map", str(bag), "--out", str(tmp_path / "x"), "--refine", "icp")
+    assert refused.returncode == 2 and refused.stderr.count("\n") == 1
+    assert "argument --refine: invalid choice: 'icp'" in refused.stderr
+
+
 @pytest.mark.parametrize(
     ("flag", "value", "expected"),
     [
@@ -482,6 +497,7 @@ FLAG_VALUES = {
     "--resolution-m": st.sampled_from(["0.05", "0.02", "0.1", "1", "0.01", "1e-6", "nan", "3"]),
     "--min-travel-m": st.sampled_from(["0", "0.5", "0.1", "1e300", "-0", "nan", "-2", "inf"]),
     "--match-margin": st.sampled_from(["0", "0.02", "0.5", "1", "2", "nan", "-0.1"]),
+    "--refine": st.sampled_from(["score", "walls", "icp"]),
 }
 
 
