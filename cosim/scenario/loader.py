@@ -76,8 +76,10 @@ def _read_source(spec: str | Path) -> tuple[str, dict[str, Any]]:
     if not looks_like_file:
         names = preset_names()
         if text_spec not in names:
+            # a name with a line break or nothing in it is shown quoted: the error is one line
+            shown = text_spec if text_spec.isprintable() and text_spec.strip() else repr(text_spec)
             raise ConfigError(
-                f"{text_spec}: not a scenario file nor a preset"
+                f"{shown}: not a scenario file nor a preset"
                 + suggest(text_spec, names)
                 + " (list them with `cosim scenarios`)"
             )
@@ -85,7 +87,8 @@ def _read_source(spec: str | Path) -> tuple[str, dict[str, Any]]:
         text = preset_text(text_spec)
     else:
         if not path.is_file():
-            raise ConfigError(f"{path}: scenario file not found")
+            shown = str(path) if str(path).isprintable() else repr(str(path))
+            raise ConfigError(f"{shown}: scenario file not found")
         return str(path), read_toml_file(path, "scenario file")
     return origin, parse_toml(text, origin)
 

@@ -195,3 +195,11 @@ def test_with_section_takes_a_name_and_a_settings_instance(name, section, argume
     scenario = cosim.load_scenario("warehouse-random")
     with pytest.raises(ArgumentError, match=rf"^Scenario.with_section\({argument}="):
         scenario.with_section(name, section)
+
+
+@pytest.mark.parametrize("spec", ["\n", " ", "ware\nhouse", "a\n/b.toml"])
+def test_a_scenario_name_with_a_line_break_or_nothing_in_it_is_refused_quoted_in_one_line(spec):
+    with pytest.raises(ConfigError) as refused:
+        cosim.load_scenario(spec)
+    message = str(refused.value)
+    assert "\n" not in message and message.startswith(repr(spec) + ":")
