@@ -32,14 +32,7 @@ import numpy.typing as npt
 from models.arrays import FloatArray
 from models.errors import ModelError
 from models.geometry.occupancy import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
-from models.mapping.kernels import (
-    accumulate_hits,
-    apply,
-    classify,
-    rebuild_scores,
-    refresh_scores,
-    traverse,
-)
+from models.mapping.kernels import apply, classify, rebuild_scores, refresh_scores, traverse
 
 COARSE = 4
 """Cells per side of the coarse score's window (the matcher's first level)."""
@@ -246,24 +239,10 @@ class LogOddsMap:
             clear_no_return_m,
             cells,
             hits,
+            self.hit_means,
+            self.hit_counts,
         )
-        flipped = self._apply(cells, hits, n)
-        if self.hit_counts.size:
-            accumulate_hits(
-                self.hit_means,
-                self.hit_counts,
-                g.origin_xy_m[0],
-                g.origin_xy_m[1],
-                g.resolution_m,
-                float(pose[0]),
-                float(pose[1]),
-                float(pose[2]),
-                np.ascontiguousarray(angles_rad, dtype=np.float64),
-                ranges,
-                range_min_m,
-                range_max_m,
-            )
-        return flipped
+        return self._apply(cells, hits, n)
 
     @property
     def has_hit_centroids(self) -> bool:

@@ -31,13 +31,18 @@ def _traverse_py(
     clear_m: float,
     cells: Any,
     hits: Any,
+    means: Any,
+    counts: Any,
 ) -> int:
     """The cells one scan updates, each once: returns first (hit), then crossed cells (miss).
 
     Writes ``iy * width + ix`` into ``cells`` and whether it is a return into ``hits``;
     returns how many. ``stamp`` marks the cells this scan (number ``scan``) has listed.
+    Every return (two in one cell both) is also folded into its cell's mean position in
+    ``means`` and ``counts`` (:func:`_fold_hit_py`), unless those are empty.
     """
     height, width = stamp.shape
+    keep_hits = counts.shape[0] > 0
     n = 0
     # returns first: a cell with a return is occupied evidence even if another beam crosses it
     for b in range(ranges.shape[0]):
@@ -45,9 +50,15 @@ def _traverse_py(
         if not (r >= range_min) or not (r <= range_max):
             continue
         a = yaw + angles[b]
-        ix = math.floor((x + r * math.cos(a) - ox) / res)
-        iy = math.floor((y + r * math.sin(a) - oy) / res)
-        if ix < 0 or iy < 0 or ix >= width or iy >= height or stamp[iy, ix] == scan:
+        hx = (x + r * math.cos(a) - ox) / res
+        hy = (y + r * math.sin(a) - oy) / res
+        ix = math.floor(hx)
+        iy = math.floor(hy)
+        if ix < 0 or iy < 0 or ix >= width or iy >= height:
+            continue
+        if keep_hits:
+            _fold_hit(means, counts, ix, iy, hx - ix, hy - iy)
+        if stamp[iy, ix] == scan:
             continue
         stamp[iy, ix] = scan
         cells[n] = iy * width + ix
@@ -105,45 +116,22 @@ def _traverse_py(
     return n
 
 
-def _accumulate_hits_py(
-    means: Any,
-    counts: Any,
-    ox: float,
-    oy: float,
-    res: float,
-    x: float,
-    y: float,
-    yaw: float,
-    angles: Any,
-    ranges: Any,
-    range_min: float,
-    range_max: float,
-) -> None:
-    """Fold every return of one scan into its cell's mean: where in the cell it fell.
+def _fold_hit_py(means: Any, counts: Any, ix: int, iy: int, dx: float, dy: float) -> None:
+    """Fold one return into its cell's mean offset ``(dx, dy)`` (cells, 0-1 each way).
 
     ``means[iy, ix]`` is the mean offset of the cell's returns from its lower-left corner
     in 255ths of a cell each way (0.2 mm at 5 cm cells), ``counts[iy, ix]`` how many it
-    holds, up to 255: past that each return still moves the mean by 1/255 of its
-    difference, so a cell follows a map that moved. Two returns in one cell both count.
+    holds, up to 255. A return moves the stored mean only if its share of the difference,
+    ``(offset - mean) / n``, rounds to at least one 255th: a cell of n returns ignores one
+    closer than about ``n / 510`` cells to its mean (half a cell when full), so a cell's
+    mean settles as its returns add up.
     """
-    height, width = counts.shape
-    for b in range(ranges.shape[0]):
-        r = ranges[b]
-        if not (r >= range_min) or not (r <= range_max):
-            continue
-        a = yaw + angles[b]
-        fx = (x + r * math.cos(a) - ox) / res
-        fy = (y + r * math.sin(a) - oy) / res
-        ix = math.floor(fx)
-        iy = math.floor(fy)
-        if ix < 0 or iy < 0 or ix >= width or iy >= height:
-            continue
-        n = min(int(counts[iy, ix]) + 1, 255)
-        for k, offset in ((0, fx - ix), (1, fy - iy)):
-            mean = means[iy, ix, k] / 255.0
-            mean += (offset - mean) / n
-            means[iy, ix, k] = min(255, max(0, round(mean * 255.0)))
-        counts[iy, ix] = n
+    n = min(int(counts[iy, ix]) + 1, 255)
+    for k, offset in ((0, dx), (1, dy)):
+        mean = means[iy, ix, k] / 255.0
+        mean += (offset - mean) / n
+        means[iy, ix, k] = min(255, max(0, round(mean * 255.0)))
+    counts[iy, ix] = n
 
 
 def _apply_py(
@@ -337,8 +325,8 @@ def _classify_py(logodds: Any, free: Any, occupied: Any, cells: Any) -> None:
             cells[iy, ix] = OCCUPIED if v >= occupied else (FREE if v <= free else UNKNOWN)
 
 
+_fold_hit: Any = numba.njit(cache=True, nogil=True, inline="always")(_fold_hit_py)
 traverse: Any = numba.njit(cache=True, nogil=True)(_traverse_py)
-accumulate_hits: Any = numba.njit(cache=True, nogil=True)(_accumulate_hits_py)
 classify: Any = numba.njit(cache=True, nogil=True)(_classify_py)
 apply: Any = numba.njit(cache=True, nogil=True)(_apply_py)
 _recompute_score: Any = numba.njit(cache=True, nogil=True)(_recompute_score_py)
@@ -347,4 +335,4 @@ _refresh_coarse: Any = numba.njit(cache=True, nogil=True)(_refresh_coarse_py)
 refresh_scores: Any = numba.njit(cache=True, nogil=True)(_refresh_scores_py)
 rebuild_scores: Any = numba.njit(cache=True, nogil=True)(_rebuild_scores_py)
 
-__all__ = ["accumulate_hits", "apply", "rebuild_scores", "refresh_scores", "traverse"]
+__all__ = ["apply", "rebuild_scores", "refresh_scores", "traverse"]

@@ -30,6 +30,7 @@ import numpy.typing as npt
 
 from models.arrays import FloatArray
 from models.errors import ModelError
+from models.mapping.gauss_newton import levenberg_step, within_cell
 from models.mapping.grid import COARSE, LogOddsMap
 from models.mapping.walls import refine_on_walls
 
@@ -234,21 +235,10 @@ def _refine_py(
             break
         best_value = total
         best = (x, y, yaw)
-        # damped normal equations (Levenberg), solved by Cramer's rule
-        lam = 1e-3 * (h00 + h11 + h22) + 1e-9
-        a00, a11, a22 = h00 + lam, h11 + lam, h22 + lam
-        m00 = a11 * a22 - h12 * h12
-        m01 = h01 * a22 - h12 * h02
-        m02 = h01 * h12 - a11 * h02
-        det = a00 * m00 - h01 * m01 + h02 * m02
-        if abs(det) < 1e-12:
+        dx, dy, dt, ok = levenberg_step(h00, h01, h02, h11, h12, h22, b0, b1, b2, 1e-3, 1e-9, 1e-12)
+        if not ok:
             break
-        dx = (b0 * m00 - h01 * (b1 * a22 - h12 * b2) + h02 * (b1 * h12 - a11 * b2)) / det
-        dy = (a00 * (b1 * a22 - h12 * b2) - b0 * m01 + h02 * (h01 * b2 - b1 * h02)) / det
-        dt = (a00 * (a11 * b2 - b1 * h12) - h01 * (h01 * b2 - b1 * h02) + b0 * m02) / det
-        x = min(x0 + res, max(x0 - res, x + dx))
-        y = min(y0 + res, max(y0 - res, y + dy))
-        yaw = min(yaw0 + 0.02, max(yaw0 - 0.02, yaw + dt))
+        x, y, yaw = within_cell((x0, y0, yaw0), x + dx, y + dy, yaw + dt, res)
     return best
 
 

@@ -22,6 +22,7 @@ import numba
 import numpy as np
 
 from models.arrays import FloatArray
+from models.mapping.gauss_newton import levenberg_step, within_cell
 from models.mapping.grid import LogOddsMap
 
 ASSOCIATION_CELLS = 1.5
@@ -46,7 +47,8 @@ def refine_on_walls(
 ) -> tuple[float, float, float]:
     """``pose`` refined so that ``points`` (sensor frame, m) lie on the map's walls.
 
-    Moves at most a cell and 0.02 rad from ``pose`` (the search's own resolution).
+    Moves at most a cell and 0.02 rad from ``pose`` (the search's own resolution:
+    :func:`models.mapping.gauss_newton.within_cell`).
 
     Raises:
         ValueError: the map does not keep its returns' centroids (``hit_centroids``).
@@ -175,21 +177,13 @@ def _refine_py(
             b2 -= jt * e
         if used < MIN_POINTS:
             break
-        # damped normal equations (Levenberg), solved by Cramer's rule
-        lam = 1e-6 * (h00 + h11 + h22) + 1e-12
-        a00, a11, a22 = h00 + lam, h11 + lam, h22 + lam
-        m00 = a11 * a22 - h12 * h12
-        m01 = h01 * a22 - h12 * h02
-        m02 = h01 * h12 - a11 * h02
-        det = a00 * m00 - h01 * m01 + h02 * m02
-        if abs(det) < 1e-18:
+        # residuals in metres (not score units): a lighter damping than the score's refine
+        dx, dy, dt, ok = levenberg_step(
+            h00, h01, h02, h11, h12, h22, b0, b1, b2, 1e-6, 1e-12, 1e-18
+        )
+        if not ok:
             break
-        dx = (b0 * m00 - h01 * (b1 * a22 - h12 * b2) + h02 * (b1 * h12 - a11 * b2)) / det
-        dy = (a00 * (b1 * a22 - h12 * b2) - b0 * m01 + h02 * (h01 * b2 - b1 * h02)) / det
-        dt = (a00 * (a11 * b2 - b1 * h12) - h01 * (h01 * b2 - b1 * h02) + b0 * m02) / det
-        x = min(x0 + res, max(x0 - res, x + dx))
-        y = min(y0 + res, max(y0 - res, y + dy))
-        yaw = min(yaw0 + 0.02, max(yaw0 - 0.02, yaw + dt))
+        x, y, yaw = within_cell((x0, y0, yaw0), x + dx, y + dy, yaw + dt, res)
         if abs(dx) < 1e-5 and abs(dy) < 1e-5 and abs(dt) < 1e-6:
             break
     return x, y, yaw

@@ -76,6 +76,10 @@ def test_robots_map_only_when_mapping_is_enabled():
             "> 0 and <= 1.6",
         ),
         (
+            {"mapping.refine": "icp"},
+            "--set mapping.refine: [mapping] refine = 'icp': expected one of 'walls', 'score'",
+        ),
+        (
             {"mapping.match_margin": 1.5},
             "--set mapping.match_margin: [mapping] match_margin = 1.5: expected a number >= 0 "
             "and <= 1",
@@ -113,12 +117,13 @@ KEYS = [
     "match_margin",
     "loop_closure",
     "share_period_s",
+    "refine",
 ]
 VALUES = st.one_of(
     st.booleans(),
     st.floats(allow_nan=True, allow_infinity=True),
     st.integers(-2, 5),
-    st.sampled_from(["none", "scans", "maps", "correlative", "x"]),
+    st.sampled_from(["none", "scans", "maps", "correlative", "x", "walls", "score"]),
 )
 
 
@@ -133,3 +138,4 @@ def test_any_mapping_values_load_consistently_or_fail_with_one_config_error_line
     assert 0.01 <= cfg.resolution_m <= 1
     assert cfg.enabled or cfg.share == NO_SHARING
     assert not (cfg.loop_closure and cfg.share == "maps")
+    assert cfg.refine in ("walls", "score")

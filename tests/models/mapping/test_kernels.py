@@ -9,7 +9,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from models.geometry.occupancy import FREE, OCCUPIED, UNKNOWN
-from models.mapping.kernels import apply, classify, rebuild_scores, refresh_scores, traverse
+from models.mapping.kernels import (
+    _fold_hit,
+    apply,
+    classify,
+    rebuild_scores,
+    refresh_scores,
+    traverse,
+)
 
 RES = 0.1
 HIT, MISS, LO, HI, OCC = 0.85, -0.08, -2.0, 3.5, 0.62
@@ -33,6 +40,8 @@ def _traverse(shape, pose, angles, ranges, *, scan=1, stamp=None, clear_m=2.0, r
         clear_m,
         cells,
         hits,
+        np.zeros((0, 0, 2), dtype=np.uint8),
+        np.zeros((0, 0), dtype=np.uint8),
     )
     width = shape[1]
     listed = [(int(c % width), int(c // width)) for c in cells[:n]]
@@ -216,3 +225,28 @@ def test_scores_refreshed_around_flipped_cells_equal_scores_rebuilt(seed, flips,
     assert net == after - before
     assert np.array_equal(score, want_score) and np.array_equal(coarse, want_coarse)
     assert not dirty.any()  # left as found, for the next scan
+
+
+def test_every_return_is_folded_into_its_cells_mean_even_when_its_cell_is_listed_already():
+    # two beams end in cell (12, 4) of 0.1 m cells, 0.25 and 0.75 of a cell in; a NaN is skipped
+    means = np.zeros((10, 20, 2), dtype=np.uint8)
+    counts = np.zeros((10, 20), dtype=np.uint8)
+    stamp = np.zeros((10, 20), dtype=np.int32)
+    cells = np.empty(4096, dtype=np.int64)
+    hits = np.empty(4096, dtype=np.bool_)
+    angles = np.zeros(3)
+    ranges = np.array([1.175, 1.225, np.nan])
+    n = traverse(
+        stamp, 1, 0.0, 0.0, RES, 0.05, 0.45, 0.0, angles, ranges, 0.05, 5.0, 2.0,
+        cells, hits, means, counts,
+    )  # fmt: skip
+    assert hits[:n].sum() == 1 and counts[4, 12] == 2 and counts.sum() == 2
+    assert np.allclose(means[4, 12] / 255, [0.5, 0.5], atol=1 / 255)
+
+
+def test_a_cell_full_of_returns_moves_only_for_returns_far_from_its_mean():
+    means = np.zeros((1, 1, 2), dtype=np.uint8)
+    counts = np.full((1, 1), 255, dtype=np.uint8)  # 255 returns at the corner already
+    for _ in range(255):
+        _fold_hit(means, counts, 0, 0, 1.0, 0.25)  # a cell away in x, a quarter in y
+    assert counts[0, 0] == 255 and means[0, 0, 0] == 128 and means[0, 0, 1] == 0

@@ -8,7 +8,7 @@ import pytest
 from models.mapping.grid import LogOddsMap, MapGeometry
 from models.mapping.matcher import MatcherParams, match, scan_points
 from models.mapping.walls import refine_on_walls
-from tests.models.mapping.conftest import ROOM, Lidar
+from tests.models.mapping.conftest import ROOM, Lidar, integrate
 
 SHIFT = np.array([0.017, 0.031, 0.017, 0.031])
 """The room moved off the grid's lines: its walls lie inside cells, not on their edges."""
@@ -21,14 +21,7 @@ def _mapped(hit_centroids: bool) -> tuple[LogOddsMap, Lidar]:
         MapGeometry.covering((-0.2, -0.2, 12.3, 8.3), 0.05, 1.0), hit_centroids=hit_centroids
     )
     for pose in [(2.0, 6.5, 0.0), (6.0, 4.0, 1.0), (10.5, 6.5, 2.0), (8.0, 2.5, -1.0)]:
-        grid.integrate(
-            pose,
-            lidar.angles,
-            lidar.scan(pose),
-            range_min_m=0.1,
-            range_max_m=10.0,
-            clear_no_return_m=3.0,
-        )
+        integrate(grid, lidar, pose)
     return grid, lidar
 
 
