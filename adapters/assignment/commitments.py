@@ -109,15 +109,30 @@ class Commitments:
         if robot.phase == "heading":
             if task is not None and task.task_id == robot.task:
                 return
-            if not self.preemption:
+            gone = self.gone(robot)
+            if not (self.preemption or gone):
                 return
-            self._release(run, robot, "re-assigned")
+            self._release(run, robot, gone or "re-assigned")
             if task is None:  # re-assigned to nothing: stop driving to the task given up
                 self._cancel(run, robot)
         if task is None:
             return
         x, y = self.pose[robot.index]
         self._take(run, robot, task, self.cost(x, y, task))
+
+    @staticmethod
+    def gone(robot: RobotTasks) -> str:
+        """Why the task ``robot`` heads to is no longer its to serve, or "" if it still is.
+
+        A new epoch's task set without it (another robot served it: the epoch was cut
+        before that robot's claim reached this one) or naming another robot its holder. A
+        robot that kept heading there would drive to a task that no longer exists and stand
+        on its station in the way of the next robot sent there.
+        """
+        for info in robot.tasks:
+            if info.task_id == robot.task:
+                return "held by " + info.holder if info.holder not in ("", robot.name) else ""
+        return "no longer open"
 
     def _take(self, run: RunContext, robot: RobotTasks, task: TaskInfo, cost: float) -> None:
         now = run.kernel.now_ns

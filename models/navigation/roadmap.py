@@ -187,6 +187,9 @@ def one_way(
 ) -> Roadmap:
     """The roadmap without the steps against a one-way lane at either end of them.
 
+    Places the lanes would cut off from the rest (short lanes in a small room can leave a
+    place only enterable, or only leavable) keep their steps both ways.
+
     Args:
         roadmap: a two-way roadmap.
         lanes: (rows, cols) lane direction per costmap cell (:mod:`models.navigation.lanes`).
@@ -202,7 +205,7 @@ def one_way(
         bad = linked & (lane == against[k])
         bad[linked] |= lane[other[linked]] == against[k]
         neighbours[bad, k] = -1
-    return Roadmap(roadmap.xy, neighbours, roadmap.spacing_m)
+    return _kept_connected(roadmap, neighbours)
 
 
 def build_roadmap(
@@ -290,12 +293,21 @@ def one_way_floor(
         forward = (line + offset) % 2 == 0  # this line runs towards +x (+y)
         bad = floor & (forward != (k in (0, 2)))
         neighbours[bad, k] = -1
+    return _kept_connected(roadmap, neighbours)
+
+
+def _kept_connected(roadmap: Roadmap, neighbours: IntArray) -> Roadmap:
+    """``roadmap`` with the steps ``neighbours`` keeps, and back both ways at stray places.
+
+    A place that the one-way steps cut off from the largest part of its component (it
+    could not reach it, or be reached from it) gets its steps back, both ways, until none
+    is cut off: one-way streets must never leave a robot where it cannot get out.
+    """
     directed = Roadmap(roadmap.xy, neighbours, roadmap.spacing_m)
     for _ in range(len(roadmap)):
         stray = _stray(roadmap.component, directed.component)
         if not stray.any():
             break
-        # a stray place gets its steps back, both ways
         restore = stray[:, None] | np.isin(roadmap.neighbours, np.flatnonzero(stray))
         neighbours = np.where(restore, roadmap.neighbours, neighbours)
         directed = Roadmap(roadmap.xy, neighbours, roadmap.spacing_m)

@@ -155,6 +155,38 @@ def test_with_preemption_a_robot_reassigned_to_no_task_stops_driving_to_the_old_
     assert cancel.goal_id == 2 and math.isnan(cancel.x_m) and math.isnan(cancel.y_m)
 
 
+def test_without_preemption_a_robot_still_gives_up_a_task_the_new_epoch_no_longer_has():
+    """Another robot served it before its claim reached this one: a ghost, not a task."""
+    b = bench()
+    r = heading(b)  # task 7
+    r.tasks = (TASKS[1],)  # the next epoch: task 7 is done
+    b.duties.act(b.run, r, None)
+    [release] = b.on(CLAIMS)
+    assert (release.task_id, release.state) == (7, "release")
+    [cancel] = b.on(goal_topic("robot_1"))
+    assert math.isnan(cancel.x_m) and r.phase == "idle"
+    assert ("robot_1", "release", "task 7: no longer open") in b.events()
+
+
+def test_without_preemption_a_robot_gives_up_a_task_another_robot_holds_for_its_next():
+    b = bench()
+    r = heading(b)  # task 7
+    r.tasks = (TaskInfo(7, 3.0, 4.0, tuple(NAMES), holder="robot_2"), TASKS[1])
+    b.duties.act(b.run, r, 1)
+    release, claim = b.on(CLAIMS)
+    assert (release.task_id, release.state, claim.task_id) == (7, "release", 8)
+    assert (r.phase, r.task) == ("heading", 8)
+    assert ("robot_1", "release", "task 7: held by robot_2") in b.events()
+
+
+def test_a_heading_robot_keeps_its_task_while_the_epoch_still_has_it_for_it():
+    b = bench()
+    r = heading(b)
+    r.tasks = (TaskInfo(7, 3.0, 4.0, tuple(NAMES), holder="robot_1"), TASKS[1])
+    b.duties.act(b.run, r, 1)
+    assert (r.phase, r.task) == ("heading", 7) and b.sent == []
+
+
 def test_a_cheaper_claim_on_the_same_task_wins_and_the_loser_gives_way():
     b = bench()
     r = heading(b)  # 5 m

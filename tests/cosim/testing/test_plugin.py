@@ -59,7 +59,7 @@ def test_the_fixture_runs_scenarios_and_a_broken_rule_is_reported_with_its_numbe
     done.stdout.fnmatch_lines(
         [
             "*test_a_users_protocol_is_registered_for_its_run*",
-            "E * AssertionError: 3 conflicts (a task claimed by two robots): task * at t = *",
+            "E * AssertionError: 5 conflicts (a task claimed by two robots): task * at t = *",
         ]
     )
 

@@ -94,6 +94,23 @@ def test_one_way_aisles_lose_their_backward_steps_and_hops_follow_the_directions
     assert len(set(directed.component.tolist())) == 1  # still one strongly connected piece
 
 
+def test_a_short_lane_that_would_leave_places_without_a_way_out_keeps_them_two_way():
+    """A 2.4 m long lane ending in a dead end: east only, its last places could not leave."""
+    obstacle = np.zeros((40, 60), dtype=bool)  # 6 m x 4 m
+    obstacle[0, :] = obstacle[-1, :] = obstacle[:, 0] = obstacle[:, -1] = True
+    obstacle[:14, 30:] = True  # the room's right half is a dead-end corridor 1.2 m wide
+    obstacle[26:, 30:] = True
+    roadmap = build_roadmap(_distance(obstacle), (0.0, 0.0), RES, 0.8, CLEARANCE)
+    assert len(set(roadmap.component.tolist())) == 1
+    lanes = np.full(obstacle.shape, TWO_WAY, dtype=np.uint8)
+    lanes[14:26, 30:] = EAST
+    directed = one_way(roadmap, lanes, (0.0, 0.0), RES)
+    assert len(set(directed.component.tolist())) == 1  # every place reaches every other
+    dead_end = np.flatnonzero(directed.xy[:, 0] > 3.0)
+    assert len(dead_end) >= 2
+    assert (directed.neighbours[dead_end, 1] >= 0).any()  # a way back west
+
+
 @settings(max_examples=60, deadline=None)
 @given(
     seed=st.integers(0, 2**32 - 1),
