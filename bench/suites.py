@@ -11,6 +11,7 @@ import numpy as np
 from assignment_bench import assignment_solve_stats
 from breakdown_bench import whole_stack_breakdown
 from cases import EVERY_ROBOT_PLANS, FULL_STACK
+from controllers_bench import controllers_fleet50, planners_fleet50
 from dwa_bench import dwa_us_per_robot
 from humans_bench import humans_coupling
 from landmarks_bench import landmark_savings
@@ -416,6 +417,8 @@ SUITES: dict[str, Callable[[int], Result]] = {
     "fleet50_navigation": fleet50_navigation,
     "fleet50_full_stack": fleet50_full_stack,
     "dwa": dwa_us_per_robot,
+    "controllers": controllers_fleet50,
+    "planners": planners_fleet50,
     "assignment": assignment_solve_stats,
     "study": study_throughput,
     "study_throughput_200": study_throughput_200,

@@ -18,8 +18,10 @@ the ``map`` frame in metres, headings in radians (REP 103).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, ClassVar, Protocol
+
+import numpy as np
 
 from adapters.navigation.fleet_traffic import FleetTraffic
 from adapters.navigation.layers import StaticLayers
@@ -76,6 +78,12 @@ class ControlInputs:
         slices: cuts the robots over the run's threads (:mod:`models.slicing`); a batch
             controller whose robots are independent may hand it to its kernel, each
             robot's command the same whatever the cut.
+        neighbours: (k, 5) what was heard of the robots in ``discs``, row for row (the
+            same ``disc_start``): ``x, y, vx, vy, age_s``, position (m) and velocity (m/s,
+            the heard speed along the heard heading) in ``map``, and the age of that news
+            (s): now minus the time the state was sent, network latency included. Empty
+            (0, 5) when the caller has none; then nothing is known of how the robots in
+            ``discs`` move.
     """
 
     pose: FloatArray
@@ -89,6 +97,7 @@ class ControlInputs:
     disc_start: IntArray
     now_ns: int
     slices: Slices = whole
+    neighbours: FloatArray = field(default_factory=lambda: np.zeros((0, 5)))
 
 
 class LocalController(Protocol):

@@ -172,8 +172,8 @@ class GoalTracker:
         assert self.drivers is not None
         self.drivers.recovery.reset(i)
         self.drivers.stalls.reset(i, self.pose[i], now_ns)
+        self.end_stall(i, now_ns)
         self.active[i] = True
-        self.stuck[i] = False
         self.best_remaining[i] = math.inf
         self.progress_ns[i] = now_ns
         self.progress_driven_m[i] = self.fleet.distance_m[i]
@@ -189,6 +189,7 @@ class GoalTracker:
         """Robot ``i`` stops driving to its goal: ``unreachable`` or ``cancelled``."""
         assert self.drivers is not None
         was_active = bool(self.active[i])
+        self.end_stall(i, run.kernel.now_ns)
         self.active[i] = False
         self.drivers.paths.clear(i)
         if self.drivers.places is not None:
@@ -208,6 +209,7 @@ class GoalTracker:
         assert self.drivers is not None
         gap = np.hypot(*(self.pose[:, :2] - self.goal).T)
         for i in np.flatnonzero(self.active & (gap <= self.goal_tolerance_m)).tolist():
+            self.end_stall(i, now_ns)
             self.active[i] = False
             self.drivers.paths.clear(i)
             if math.isnan(self.records.shortest_m[i]):
@@ -222,10 +224,11 @@ class GoalTracker:
     def track(self, run: RunContext, now_ns: int, remaining: FloatArray) -> None:
         """Note progress on the way left (m) of every robot; say ``stuck`` once per stall."""
         improved = self.active & (remaining < self.best_remaining - PROGRESS_M)
+        for i in np.flatnonzero(improved & self.stuck).tolist():
+            self.end_stall(i, now_ns)
         self.best_remaining[improved] = remaining[improved]
         self.progress_ns[improved] = now_ns
         self.progress_driven_m[improved] = self.fleet.distance_m[improved]
-        self.stuck[improved] = False
         timeout = s_to_ns(self.stuck_timeout_s)
         late = self.active & ~self.stuck & (now_ns - self.progress_ns >= timeout)
         for i in np.flatnonzero(late).tolist():
@@ -245,6 +248,21 @@ class GoalTracker:
             )
             self.records.stuck(kind)
             self.status(run, i, "stuck", float(remaining[i]))
+
+    def end_stall(self, i: int, now_ns: int) -> None:
+        """Robot ``i``'s stall, if it was reported stuck, ends now: count its time stuck.
+
+        A stall counts from the robot's last progress (the whole stall, not only the part
+        after the report) to its next progress, arrival, drop, new goal or the run's end.
+        """
+        if self.stuck[i]:
+            self.stuck[i] = False
+            self.records.stalled((now_ns - int(self.progress_ns[i])) / 1e9)
+
+    def close(self, now_ns: int) -> None:
+        """The run ends: stalls still going count up to now."""
+        for i in np.flatnonzero(self.stuck).tolist():
+            self.end_stall(i, now_ns)
 
     def report(self, run: RunContext, remaining: FloatArray) -> None:
         """Publish ``progress`` with the way left (m) for every robot with a goal."""

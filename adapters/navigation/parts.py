@@ -142,7 +142,7 @@ def build_parts(run: RunContext) -> NavigationParts:
     moving = MovingMemory(s_to_ns(cfg.obstacle_memory_s), layers.resolution_m)
     paths = PathBook(n)
     robots_layer = _robots_layer(run, cfg, names, hosts, radius, mapping=mapping)
-    records = NavRecords(run.recorder, names)
+    records = NavRecords(run.recorder, names, max_speed_mps=limits.max_speed_mps)
     rngs = [run.rng.stream(f"navigation/{name}") for name in names]
     control = controller_registry().get(cfg.controller)(
         ControllerContext(run, limits, fleet.radius_m, cfg.control_hz)

@@ -21,6 +21,7 @@ topics wired in :mod:`adapters.navigation.wiring`.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Mapping
 from typing import Any, ClassVar
 
@@ -35,6 +36,7 @@ from adapters.navigation.contract import (
 )
 from adapters.navigation.fleet_traffic import FleetTraffic
 from adapters.navigation.memory import check_navigation_memory
+from adapters.navigation.motion_quality import MOTION_SUMMARY, MotionQuality
 from adapters.navigation.parts import build_parts
 from adapters.navigation.settings import NavigationConfig
 from adapters.navigation.tables import NAV_SUMMARY, NAVIGATION
@@ -66,6 +68,7 @@ class NavigationAdapter:
     """The tables it writes (documented in the table reference)."""
     summary_keys: ClassVar[Mapping[str, SummaryKey]] = {
         **NAV_SUMMARY,
+        **MOTION_SUMMARY,
         "goals_active_at_end": SummaryKey("count", "goals still being driven to at the end"),
         "controller_commands_clipped": SummaryKey(
             "count", "local controller commands clipped to the robots' drive limits"
@@ -100,6 +103,7 @@ class NavigationAdapter:
         self.pose = self.parts.pose
         self.clipped = 0
         """Robot commands of the local controller clipped to the drive limits, so far."""
+        self.quality = MotionQuality(len(self.parts.names), self.cfg.control_hz)
         self.workers = run.workers
 
     # -- the bus ----------------------------------------------------------------------
@@ -157,6 +161,8 @@ class NavigationAdapter:
         carrots = keep_right(carrots, moving, self.pose, active, parts.traffic)
         v, w, blocked = self._local_control(carrots, goal, points, start, moving, now_ns)
         moving_ok = active & ~lost
+        fleet = parts.goals.fleet
+        self.quality.sample(fleet.v, fleet.w, moving_ok)
         v = np.where(moving_ok, v, 0.0)
         w_cmd = np.where(moving_ok, w, 0.0)
         parts.goals.track(run, now_ns, remaining)
@@ -218,9 +224,10 @@ class NavigationAdapter:
         parts = self.parts
         n = len(parts.names)
         if parts.robots_layer is None:
-            discs, disc_start = np.zeros((0, 3)), np.zeros(n + 1, dtype=np.int64)
+            discs, neighbours = np.zeros((0, 3)), np.zeros((0, 5))
+            disc_start = np.zeros(n + 1, dtype=np.int64)
         else:
-            discs, disc_start = parts.robots_layer.all_discs(now_ns)
+            discs, neighbours, disc_start = parts.robots_layer.all_neighbours(now_ns)
         vel = parts.localization.vel
         inputs = ControlInputs(
             self.pose,
@@ -234,8 +241,11 @@ class NavigationAdapter:
             disc_start,
             now_ns,
             self.workers.chunks,
+            neighbours,
         )
+        started = time.perf_counter()
         returned = parts.control.commands(inputs)
+        self.quality.decided(time.perf_counter() - started)
         v, w, blocked, clipped = checked_commands(
             parts.control, returned, parts.names, parts.limits
         )
@@ -255,10 +265,12 @@ class NavigationAdapter:
 
     def finish(self, run: RunContext) -> Mapping[str, Any]:
         """Arrivals, time to goal, path-length ratio, deadlocks, replans, recoveries, clips."""
+        self.parts.goals.close(run.kernel.now_ns)
         summary = self.parts.records.summary(run.kernel.now_ns / NS_PER_S)
         active = int(self.parts.goals.active.sum())
         summary["goals_active_at_end"] = active
         summary["controller_commands_clipped"] = self.clipped
+        summary.update(self.quality.summary())
         # accepted goals neither reached nor still being driven to: abandoned after `stuck`
         accepted = summary["goals"] - summary["goals_unreachable"]
         summary["goals_missed"] = accepted - summary["arrivals"] - active

@@ -30,6 +30,8 @@ VOLATILE_METRICS = (
     "humans_sumo_in_process",
     "threads",
     "thread_busy",
+    "controller_ms_per_tick",
+    "controller_us_per_robot",
 )
 """Summary entries that depend on the machine or executor, not on the scenario and seed."""
 

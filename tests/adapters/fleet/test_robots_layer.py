@@ -2,6 +2,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+import pytest
 
 from adapters.fleet.robots_layer import RobotsLayer
 from adapters.fleet.topics import ROBOT_STATES
@@ -114,3 +115,43 @@ def test_an_empty_fleet_packs_to_no_discs():
     layer = RobotsLayer([], [], RADIUS_M, 1.0)
     discs, start = layer.all_discs(0)
     assert discs.shape == (0, 3) and start.tolist() == [0]
+
+
+def test_each_robot_knows_the_others_velocities_in_map_row_for_row_with_their_discs():
+    run, layer, _, _ = started()
+    run.kernel.run(s_to_ns(0.05))  # heard at 20 ms what was sent at 0
+    now = run.kernel.now_ns
+    neighbours = layer.neighbours(0, now)
+    assert neighbours.shape == (2, 5)
+    np.testing.assert_allclose(neighbours[:, :2], layer.discs(0, now)[:, :2])
+    # robot_2 stands still; robot_3 drives at 0.2 m/s heading -1 rad
+    np.testing.assert_allclose(neighbours[0, 2:4], [0.0, 0.0], atol=1e-12)
+    np.testing.assert_allclose(neighbours[1, 2:4], [0.2 * np.cos(-1.0), 0.2 * np.sin(-1.0)])
+    # robot_1's own heading 0 at 0.5 m/s, as robot_2 heard it
+    np.testing.assert_allclose(layer.neighbours(1, now)[0, 2:4], [0.5, 0.0], atol=1e-12)
+
+
+def test_the_age_of_what_a_robot_heard_counts_from_when_it_was_sent_so_latency_is_part_of_it():
+    run, layer, _, _ = started()
+    run.kernel.run(s_to_ns(0.05))
+    now = run.kernel.now_ns  # the latest state was sent at 0 and arrived at 20 ms
+    assert layer.neighbours(0, now)[:, 4].tolist() == [now / 1e9, now / 1e9]
+    assert layer.neighbours(0, s_to_ns(0.07))[:, 4] == pytest.approx([0.07, 0.07])
+    run.kernel.run(s_to_ns(0.125))  # the state sent at 0.1 s arrived at 0.12 s
+    assert layer.neighbours(0, s_to_ns(0.125))[:, 4] == pytest.approx([0.025, 0.025])
+
+
+def test_every_robots_neighbours_pack_row_for_row_with_the_discs():
+    run, layer, _, speeds = started(silent="robot_3")
+    speeds[1] = 0.4
+    run.kernel.run(s_to_ns(0.15))
+    now = run.kernel.now_ns
+    discs, neighbours, start = layer.all_neighbours(now)
+    assert (discs.tolist(), start.tolist()) == tuple(x.tolist() for x in layer.all_discs(now))
+    assert neighbours.shape == (len(discs), 5)
+    for i in range(3):
+        rows = slice(start[i], start[i + 1])
+        assert neighbours[rows].tolist() == layer.neighbours(i, now).tolist()
+        np.testing.assert_array_equal(neighbours[rows, :2], discs[rows, :2])
+    empty = RobotsLayer([], [], RADIUS_M, 1.0).all_neighbours(0)
+    assert [a.shape for a in empty[:2]] == [(0, 3), (0, 5)] and empty[2].tolist() == [0]

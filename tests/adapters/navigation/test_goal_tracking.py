@@ -153,6 +153,28 @@ def test_progress_ends_a_stall_and_a_new_stall_is_said_again(goals: Goals):
     assert [s for _, s in goals.states()].count("stuck") == 2
 
 
+def test_time_stuck_runs_from_the_last_progress_to_the_next_or_to_the_end(goals: Goals):
+    goals.give(0, 2.0, 6.0)
+    goals.tracker.track(goals.run, s_to_ns(0.1), np.array([4.0, 0.0, 0.0]))  # progress
+    goals.tracker.track(goals.run, s_to_ns(2.2), np.array([4.0, 0.0, 0.0]))  # stuck
+    goals.tracker.track(goals.run, s_to_ns(2.5), np.array([3.5, 0.0, 0.0]))  # progress
+    assert goals.parts.records.stuck_s == pytest.approx(2.4)  # the whole stall, 0.1-2.5 s
+    goals.tracker.track(goals.run, s_to_ns(4.6), np.array([3.5, 0.0, 0.0]))  # stuck again
+    goals.tracker.close(s_to_ns(6.0))  # the run ends in the stall
+    assert goals.parts.records.stuck_s == pytest.approx(2.4 + 3.5)
+    goals.tracker.close(s_to_ns(9.0))  # counted once
+    assert goals.parts.records.stuck_s == pytest.approx(5.9)
+
+
+def test_a_stall_without_a_stuck_report_is_not_time_stuck(goals: Goals):
+    goals.give(0, 2.0, 6.0)
+    goals.tracker.track(goals.run, s_to_ns(0.1), np.array([4.0, 0.0, 0.0]))
+    goals.tracker.track(goals.run, s_to_ns(1.5), np.array([4.0, 0.0, 0.0]))  # under 2 s
+    goals.tracker.track(goals.run, s_to_ns(1.8), np.array([3.5, 0.0, 0.0]))
+    goals.tracker.close(s_to_ns(3.0))
+    assert goals.parts.records.stuck_s == 0.0
+
+
 def test_a_way_shrinking_by_less_than_the_progress_step_is_no_progress(goals: Goals):
     goals.give(0, 2.0, 6.0)
     goals.tracker.track(goals.run, 0, np.array([4.0, 0.0, 0.0]))

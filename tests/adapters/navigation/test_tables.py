@@ -16,7 +16,7 @@ ROBOTS = ["robot_1", "robot_2"]
 
 def _records() -> tuple[Recorder, NavRecords]:
     recorder = Recorder()
-    return recorder, NavRecords(recorder, ROBOTS)
+    return recorder, NavRecords(recorder, ROBOTS, max_speed_mps=0.5)
 
 
 def _rows(recorder: Recorder) -> list[dict[str, object]]:
@@ -38,6 +38,8 @@ def test_the_table_declares_its_columns_with_units_and_plan_ms_as_volatile():
         "goal_x_m",
         "goal_y_m",
         "path_length_m",
+        "shortest_m",
+        "lost_s",
         "plan_ms",
         "detail",
     )
@@ -58,6 +60,8 @@ def test_a_row_is_one_event_of_one_robot_in_seconds():
         "goal_x_m": 3.0,
         "goal_y_m": 4.0,
         "path_length_m": 5.25,
+        "shortest_m": row["shortest_m"],
+        "lost_s": row["lost_s"],
         "plan_ms": 0.8,
         "detail": "",
     }
@@ -68,7 +72,7 @@ def test_rows_without_a_plan_leave_its_columns_empty():
     recorder, records = _records()
     records.row(0, 0, "goal", 1.0, 2.0)
     [row] = _rows(recorder)
-    assert math.isnan(row["path_length_m"]) and math.isnan(row["plan_ms"])  # type: ignore[arg-type]
+    assert all(math.isnan(row[k]) for k in ("path_length_m", "plan_ms", "shortest_m", "lost_s"))  # type: ignore[arg-type]
 
 
 @pytest.mark.parametrize("event", ["stuck", "unreachable", "arrived", "off_map", "on_map"])
@@ -94,6 +98,26 @@ def test_an_arrival_records_the_time_to_goal_and_the_ratio_to_the_shortest_way()
     assert _rows(recorder)[-1]["path_length_m"] == 10.0  # driven for this goal
 
 
+def test_an_arrival_says_how_much_time_it_lost_against_its_shortest_way_at_full_speed():
+    recorder, records = _records()  # 0.5 m/s
+    records.start_goal(0, s_to_ns(10.0), driven_m=0.0, shortest_m=4.0)  # 8 s at full speed
+    records.arrived(s_to_ns(30.0), 0, 5.0, 6.0, driven_m=6.0)  # took 20 s
+    row = _rows(recorder)[-1]
+    assert (row["shortest_m"], row["lost_s"]) == (4.0, 12.0)
+    records.start_goal(1, s_to_ns(0.0), driven_m=0.0, shortest_m=4.0)
+    records.arrived(s_to_ns(15.0), 1, 5.0, 6.0, driven_m=4.2)  # 15 s: under twice 8 s
+    summary = records.summary(30.0)
+    assert summary["time_lost_s"] == 19.0 and summary["time_lost_max_s"] == 12.0
+    assert summary["arrivals_over_twice"] == 1  # the 20 s one
+
+
+def test_time_stuck_adds_up_the_stalls_it_is_told_of():
+    _, records = _records()
+    records.stalled(31.5)
+    records.stalled(40.0)
+    assert records.summary(100.0)["stuck_s"] == 71.5
+
+
 def test_goals_next_to_the_robot_say_nothing_about_path_quality():
     _, records = _records()
     records.start_goal(1, 0, driven_m=0.0, shortest_m=0.4)
@@ -109,6 +133,10 @@ def test_the_summary_counts_goals_arrivals_stalls_by_kind_and_averages():
         "mean_time_to_goal_s": None,
         "path_length_ratio": None,
         "deadlocks": 0,
+        "stuck_s": 0.0,
+        "time_lost_s": 0.0,
+        "time_lost_max_s": None,
+        "arrivals_over_twice": 0,
         **{f"stuck_{kind}": 0 for kind in STUCK_KINDS},
         "goals_unreachable": 0,
         "replans": 0,

@@ -76,7 +76,9 @@ def test_entries_come_cosims_first_then_other_packages_by_name(tmp_path: Path):
     write_package(tmp_path, "Akit", "1", {"cosim.planners": {"aa": "akit.p:P"}})
     with on_path(tmp_path):
         packages = [p.package for p in installed() if p.group == "cosim.planners"]
-        assert packages == ["cosim", "Akit", "zkit"]
-        assert list(entries("cosim.planners")) == ["astar", "aa", "zz"]
+        assert packages == ["cosim", "cosim", "cosim", "Akit", "zkit"]
+        assert list(entries("cosim.planners")) == [
+            "astar", "hybrid_astar", "thetastar", "aa", "zz"
+        ]  # fmt: skip
         assert entries("cosim.planners")["aa"].owner() == "Akit 1"
         assert entries("cosim.planners")["astar"].owner() == "cosim"

@@ -156,7 +156,7 @@ def test_a_registry_two_packages_register_is_refused_by_name(tmp_path):
             listing = cosim_main("plugins")  # every other registry, and the clash
             assert listing.returncode == 2
             assert "registries (cosim.registries): 1 clashing\n  cosim.planners" in listing.stdout
-            assert "local controllers (cosim.controllers): 1" in listing.stdout
+            assert "local controllers (cosim.controllers): 4" in listing.stdout
     finally:
         group_named.cache_clear()
 
