@@ -13,7 +13,8 @@ STUDY = $(BIN)/cosim study studies/$(1).toml --out $(STUDIES)/$(1) --resume
 .PHONY: setup demo test test-fast docs lint bench bench-peers clean help reproduce study-comm study-comm-reduced \
 	study-burst study-scale study-paper study-nav study-mapping study-mapping-reduced \
 	study-mapping-acceptance study-mapping-defaults study-mapping-drift map-aces map-fr079 \
-	lab-real lab-mixed study-humans study-humans-reduced study-humans-contacts study-traffic
+	lab-real lab-mixed study-humans study-humans-reduced study-humans-contacts study-traffic \
+	study-local-replanning study-local-replanning-network
 
 help:  ## list the targets
 	@grep -E '^[a-z-]+:.*##' $(MAKEFILE_LIST) | sed 's/:.*## /\t/'
@@ -108,6 +109,12 @@ study-mapping-defaults: setup  ## warehouse-random with only mapping on and drif
 
 study-traffic: setup  ## traffic policies 'none', 'lanes', 'pibt' x 25/50 robots, 10 seeds x 300 s (about 7 min)
 	$(call STUDY,traffic)
+
+study-local-replanning: setup  ## every controller x planner on warehouse-humans, 0 and 10 workers, 8 seeds x 120 s (about 6 min)
+	$(call STUDY,local_replanning)
+
+study-local-replanning-network: setup  ## dwa and orca in the lab room over network latency and loss, 4 seeds x 120 s (about 2 min)
+	$(call STUDY,local_replanning_network)
 
 study-humans: setup  ## robots among 0-20 SUMO-driven workers, 5 seeds x 300 s (about 3 min)
 	$(call STUDY,humans)
