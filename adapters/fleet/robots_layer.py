@@ -125,10 +125,6 @@ class RobotsLayer:
             )
             run.bus.publish(ROBOT_STATES, state, host)
 
-    def _recent(self, i: int, now_ns: int) -> list[Heard]:
-        """What robot ``i`` heard from the others within the timeout, in the order first heard."""
-        return [h for h in self.others[i].values() if now_ns - h.t_recv_ns <= self.timeout_ns]
-
     def discs(self, i: int, now_ns: int) -> FloatArray:
         """(k, 3) discs ``x, y, r`` (m, ``map``) of the robots ``i`` heard from recently."""
         return self._known(i, now_ns)[0]
