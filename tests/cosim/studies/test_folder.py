@@ -245,9 +245,9 @@ def test_a_full_disk_mid_study_exits_2_in_one_line_and_keeps_the_finished_runs(
 @pytest.mark.slow
 def test_a_disk_too_full_for_the_results_keeps_every_run_for_resume(tmp_path, tmpfs, monkeypatch):
     path = small_study(tmp_path)
-    # a plan page and three runs of four pages (summary.json's plugins take two) fit;
-    # results.parquet (some 35 KiB) does not
-    disk = tmpfs(56)
+    # a plan page and three runs of six pages (scenario.toml's sections take two,
+    # summary.json's plugins three) fit; results.parquet (some 42 KiB) does not
+    disk = tmpfs(80)
     if disk is None:
         _full_after(monkeypatch, pd.DataFrame, "to_parquet", 0, path_at=1)
     out = (disk or tmp_path) / "out"
