@@ -10,8 +10,8 @@ import pandas as pd
 import pytest
 
 import cosim
-from cosim.testing.outcomes import VOLATILE
 from adapters.navigation.astar import AStar
+from cosim.testing.outcomes import VOLATILE
 
 WALL_CLOCK_COLUMNS = {"plan_ms"}
 """Table columns that measure the machine (how long a plan took), not the simulation."""
