@@ -103,7 +103,15 @@ def _traverse_py(
                 n += 1
             if at_end:
                 break
-            if t_max_x < t_max_y:
+            # an axis already at the end cell's index is not stepped again: a component of
+            # the direction too small to move the end point (its floor computed in floats)
+            # would otherwise step the chain off the end cell for good
+            along_x = t_max_x < t_max_y
+            if ix == end_x and iy != end_y:
+                along_x = False
+            elif iy == end_y and ix != end_x:
+                along_x = True
+            if along_x:
                 if t_max_x > limit:
                     break
                 t_max_x += t_dx
