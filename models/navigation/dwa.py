@@ -58,8 +58,7 @@ other head-on in corridors of 2.4 m and more, and still drive aisles at full spe
 from __future__ import annotations
 
 import math
-from dataclasses import astuple, dataclass, fields
-from functools import lru_cache
+from dataclasses import dataclass, fields
 from typing import Any, NamedTuple
 
 import numba
@@ -68,6 +67,7 @@ import numpy as np
 from models.arrays import BoolArray, FloatArray, IntArray
 from models.errors import ModelError
 from models.fleet.kinematics import DriveLimits
+from models.navigation.fleet_inputs import check_limits, fleet_rows, offsets, packed, points
 from models.slicing import Slices, whole
 
 
@@ -314,24 +314,6 @@ def _dwa_py(
 _dwa: Any = numba.njit(cache=True, nogil=True)(_dwa_py)
 
 
-def _csr(start: IntArray, count: int, items: int, name: str) -> IntArray:
-    offsets = np.ascontiguousarray(start, dtype=np.int64)
-    if offsets.shape != (count + 1,):
-        raise ValueError(f"{name} must be ({count + 1},), got {offsets.shape}")
-    if offsets[0] != 0 or offsets[-1] != items or np.any(np.diff(offsets) < 0):
-        raise ValueError(f"{name} must rise from 0 to {items}, got {offsets.tolist()}")
-    return offsets
-
-
-@lru_cache(maxsize=16)
-def _config(params: DwaParams, limits: DriveLimits) -> FloatArray:
-    """The kernel's flat parameter vector, built once (``astuple`` copies deeply every call).
-
-    Shared between calls: the kernel only reads it.
-    """
-    return np.array(astuple(params) + astuple(limits), dtype=np.float64)
-
-
 def dwa_batch(
     poses: FloatArray,
     velocities: FloatArray,
@@ -371,23 +353,14 @@ def dwa_batch(
         ValueError: an array has the wrong shape, or offsets do not index the points.
         ModelError: the speed limit is not positive.
     """
-    given = {"poses": poses, "velocities": velocities, "radius_m": radius_m}
-    given |= {"carrots": carrots, "goals": goals}
-    n = len(poses)
-    for (name, array), width in zip(given.items(), (3, 2, 0, 2, 2), strict=True):
-        shape = (n, width) if width else (n,)
-        if np.shape(array) != shape:
-            raise ValueError(f"{name} must be {shape}, got {np.shape(array)}")
-    if not limits.max_speed_mps > 0.0:
-        raise ModelError("robots.max_speed_mps", limits.max_speed_mps, "a speed > 0 (m/s)")
-    state = np.column_stack([np.asarray(a, dtype=np.float64) for a in given.values()])
-    pts = np.ascontiguousarray(obstacles, dtype=np.float64).reshape(-1, 2)
-    dsc = np.ascontiguousarray(discs, dtype=np.float64).reshape(-1, 3)
-    pts_start = _csr(obstacle_start, n, len(pts), "obstacle_start")
-    dsc_start = _csr(disc_start, n, len(dsc), "disc_start")
-    cfg = _config(params, limits)
+    rows = fleet_rows(poses, velocities, radius_m, carrots, goals)
+    check_limits(limits)
+    n = len(rows)
+    pts, dsc = points(obstacles, 2), points(discs, 3)
+    pts_start = offsets(obstacle_start, n, len(pts), "obstacle_start")
+    dsc_start = offsets(disc_start, n, len(dsc), "disc_start")
+    cfg = packed(params, limits)
     out = np.zeros((n, 4))
-    rows = np.ascontiguousarray(state)
 
     def decide(first: int, stop: int) -> None:
         # the offsets stay absolute: a slice of robots reads its own points and discs

@@ -52,6 +52,7 @@ import numpy as np
 from models.arrays import BoolArray, FloatArray, IntArray
 from models.errors import ModelError
 from models.fleet.kinematics import DriveLimits
+from models.navigation.fleet_inputs import check_limits, fleet_rows, offsets, points
 from models.slicing import Slices, whole
 
 
@@ -314,14 +315,6 @@ def _mppi_py(
 _mppi: Any = numba.njit(cache=True, nogil=True)(_mppi_py)
 
 
-def _offsets(start: IntArray, count: int, items: int, name: str) -> IntArray:
-    offsets = np.ascontiguousarray(start, dtype=np.int64)
-    rises = offsets.shape == (count + 1,) and offsets[0] == 0 and offsets[-1] == items
-    if not rises or np.any(np.diff(offsets) < 0):
-        raise ValueError(f"{name} must rise from 0 to {items} in {count + 1}, got {start}")
-    return offsets
-
-
 def mppi_batch(
     poses: FloatArray,
     velocities: FloatArray,
@@ -367,25 +360,20 @@ def mppi_batch(
         ValueError: an array has the wrong shape, or offsets do not index the points.
         ModelError: the speed limit is not positive.
     """
-    n, knots = len(poses), noise_knots(params)
-    given = (poses, velocities, radius_m, carrots, goals, nominal, noise)
-    shapes = {"poses": (n, 3), "velocities": (n, 2), "radius_m": (n,), "carrots": (n, 2)}
-    shapes |= {"goals": (n, 2), "nominal": (n, params.time_steps, 2)}
-    shapes["noise"] = (n, knots, 2, params.samples)
-    for (name, shape), array in zip(shapes.items(), given, strict=True):
+    rows = fleet_rows(poses, velocities, radius_m, carrots, goals)
+    n, knots = len(rows), noise_knots(params)
+    shapes = {"nominal": (n, params.time_steps, 2), "noise": (n, knots, 2, params.samples)}
+    for (name, shape), array in zip(shapes.items(), (nominal, noise), strict=True):
         if np.shape(array) != shape:
             raise ValueError(f"{name} must be {shape}, got {np.shape(array)}")
     if nominal.dtype != np.float64 or not nominal.flags.c_contiguous:
         raise ValueError("nominal must be C-contiguous float64: it is updated in place")
-    if not limits.max_speed_mps > 0.0:
-        raise ModelError("robots.max_speed_mps", limits.max_speed_mps, "a speed > 0 (m/s)")
-    rows = np.column_stack([np.asarray(a, dtype=np.float64) for a in given[:5]])
+    check_limits(limits)
     draws = np.array(noise, dtype=np.float64)  # a copy: the first sample is the nominal
     draws[:, :, :, 0] = 0.0
-    pts = np.ascontiguousarray(obstacles, dtype=np.float64).reshape(-1, 2)
-    dsc = np.ascontiguousarray(discs, dtype=np.float64).reshape(-1, 3)
-    pts_start = _offsets(obstacle_start, n, len(pts), "obstacle_start")
-    dsc_start = _offsets(disc_start, n, len(dsc), "disc_start")
+    pts, dsc = points(obstacles, 2), points(discs, 3)
+    pts_start = offsets(obstacle_start, n, len(pts), "obstacle_start")
+    dsc_start = offsets(disc_start, n, len(dsc), "disc_start")
     cfg = [float(getattr(params, name)) for name in _CFG] + [float(params.knot_steps)]
     cfg += [limits.max_speed_mps, limits.max_reverse_mps, limits.max_yaw_rate_radps]
     packed = np.array([*cfg, limits.max_accel_mps2, limits.max_yaw_accel_radps2])

@@ -56,8 +56,7 @@ Each robot's command depends only on its own inputs, whatever the batch.
 from __future__ import annotations
 
 import math
-from dataclasses import astuple, dataclass, fields
-from functools import lru_cache
+from dataclasses import dataclass, fields
 from typing import Any, NamedTuple
 
 import numba
@@ -67,6 +66,7 @@ from models.arrays import BoolArray, FloatArray, IntArray
 from models.errors import ModelError
 from models.fleet.kinematics import DriveLimits
 from models.geometry.angles import wrap_angle
+from models.navigation.fleet_inputs import check_limits, fleet_rows, offsets, packed, points
 from models.navigation.orca_lp import det as _det
 from models.navigation.orca_lp import half_plane as _half_plane
 from models.navigation.orca_lp import lp2 as _lp2
@@ -270,21 +270,6 @@ def _orca_py(
 _orca: Any = numba.njit(cache=True, nogil=True)(_orca_py)
 
 
-def _csr(start: IntArray, count: int, items: int, name: str) -> IntArray:
-    offsets = np.ascontiguousarray(start, dtype=np.int64)
-    if offsets.shape != (count + 1,):
-        raise ValueError(f"{name} must be ({count + 1},), got {offsets.shape}")
-    if offsets[0] != 0 or offsets[-1] != items or np.any(np.diff(offsets) < 0):
-        raise ValueError(f"{name} must rise from 0 to {items}, got {offsets.tolist()}")
-    return offsets
-
-
-@lru_cache(maxsize=16)
-def _config(params: OrcaParams, limits: DriveLimits) -> FloatArray:
-    """The kernel's flat parameter vector, built once; the kernel only reads it."""
-    return np.array(astuple(params) + astuple(limits), dtype=np.float64)
-
-
 def orca_half_plane(
     rel_position: FloatArray,
     rel_velocity: FloatArray,
@@ -359,27 +344,16 @@ def orca_batch(
         ValueError: an array has the wrong shape, or offsets do not index the rows.
         ModelError: the speed limit is not positive.
     """
-    given = {"poses": poses, "velocities": velocities, "radius_m": radius_m}
-    given |= {"carrots": carrots, "goals": goals}
-    n = len(poses)
-    for (name, array), width in zip(given.items(), (3, 2, 0, 2, 2), strict=True):
-        shape = (n, width) if width else (n,)
-        if np.shape(array) != shape:
-            raise ValueError(f"{name} must be {shape}, got {np.shape(array)}")
-    if not limits.max_speed_mps > 0.0:
-        raise ModelError("robots.max_speed_mps", limits.max_speed_mps, "a speed > 0 (m/s)")
-    rows = np.ascontiguousarray(
-        np.column_stack([np.asarray(a, dtype=np.float64) for a in given.values()])
-    )
-    pts = np.ascontiguousarray(hits, dtype=np.float64).reshape(-1, 2)
-    dsc = np.asarray(discs, dtype=np.float64).reshape(-1, 3)
-    heard = np.asarray(neighbours, dtype=np.float64).reshape(-1, 5)
+    rows = fleet_rows(poses, velocities, radius_m, carrots, goals)
+    check_limits(limits)
+    n = len(rows)
+    pts, dsc, heard = points(hits, 2), points(discs, 3), points(neighbours, 5)
     if len(heard) != len(dsc):
         raise ValueError(f"neighbours must be ({len(dsc)}, 5) like discs, got {heard.shape}")
     others = np.ascontiguousarray(np.column_stack([heard, dsc[:, 2]]))
-    pts_start = _csr(hit_start, n, len(pts), "hit_start")
-    oth_start = _csr(disc_start, n, len(others), "disc_start")
-    cfg = _config(params, limits)
+    pts_start = offsets(hit_start, n, len(pts), "hit_start")
+    oth_start = offsets(disc_start, n, len(others), "disc_start")
+    cfg = packed(params, limits)
     out = np.zeros((n, 5))
 
     def decide(first: int, stop: int) -> None:

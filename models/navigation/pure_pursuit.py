@@ -43,8 +43,7 @@ Every robot's command depends only on its own row: the same whatever the batch.
 from __future__ import annotations
 
 import math
-from dataclasses import astuple, dataclass, fields
-from functools import lru_cache
+from dataclasses import dataclass, fields
 from typing import Any, NamedTuple
 
 import numba
@@ -53,6 +52,7 @@ import numpy as np
 from models.arrays import BoolArray, FloatArray, IntArray
 from models.errors import ModelError
 from models.fleet.kinematics import DriveLimits
+from models.navigation.fleet_inputs import check_limits, fleet_rows, offsets, packed, points
 from models.slicing import Slices, whole
 
 
@@ -279,21 +279,6 @@ def _rpp_py(
 _rpp: Any = numba.njit(cache=True, nogil=True)(_rpp_py)
 
 
-def _offsets(start: IntArray, count: int, items: int, name: str) -> IntArray:
-    offsets = np.ascontiguousarray(start, dtype=np.int64)
-    if offsets.shape != (count + 1,):
-        raise ValueError(f"{name} must be ({count + 1},), got {offsets.shape}")
-    if offsets[0] != 0 or offsets[-1] != items or np.any(np.diff(offsets) < 0):
-        raise ValueError(f"{name} must rise from 0 to {items}, got {offsets.tolist()}")
-    return offsets
-
-
-@lru_cache(maxsize=16)
-def _config(params: RppParams, limits: DriveLimits) -> FloatArray:
-    """The kernel's flat parameter vector, built once per parameters (read only)."""
-    return np.array(astuple(params) + astuple(limits), dtype=np.float64)
-
-
 def rpp_batch(
     poses: FloatArray,
     velocities: FloatArray,
@@ -333,24 +318,14 @@ def rpp_batch(
         ValueError: an array has the wrong shape, or offsets do not index the points.
         ModelError: a speed or acceleration limit is not positive.
     """
-    given = {"poses": poses, "velocities": velocities, "radius_m": radius_m}
-    given |= {"carrots": carrots, "goals": goals}
-    n = len(poses)
-    for (name, array), width in zip(given.items(), (3, 2, 0, 2, 2), strict=True):
-        shape = (n, width) if width else (n,)
-        if np.shape(array) != shape:
-            raise ValueError(f"{name} must be {shape}, got {np.shape(array)}")
-    for key in ("max_speed_mps", "max_accel_mps2", "max_yaw_accel_radps2"):
-        if not getattr(limits, key) > 0.0:
-            raise ModelError(f"robots.{key}", getattr(limits, key), "a number > 0")
-    state = np.column_stack([np.asarray(a, dtype=np.float64) for a in given.values()])
-    pts = np.ascontiguousarray(obstacles, dtype=np.float64).reshape(-1, 2)
-    dsc = np.ascontiguousarray(discs, dtype=np.float64).reshape(-1, 3)
-    pts_start = _offsets(obstacle_start, n, len(pts), "obstacle_start")
-    dsc_start = _offsets(disc_start, n, len(dsc), "disc_start")
-    cfg = _config(params, limits)
+    rows = fleet_rows(poses, velocities, radius_m, carrots, goals)
+    check_limits(limits, "max_accel_mps2", "max_yaw_accel_radps2")
+    n = len(rows)
+    pts, dsc = points(obstacles, 2), points(discs, 3)
+    pts_start = offsets(obstacle_start, n, len(pts), "obstacle_start")
+    dsc_start = offsets(disc_start, n, len(dsc), "disc_start")
+    cfg = packed(params, limits)
     out = np.zeros((n, 4))
-    rows = np.ascontiguousarray(state)
 
     def decide(first: int, stop: int) -> None:
         # the offsets stay absolute: a slice of robots reads its own points and discs

@@ -9,10 +9,10 @@ import pytest
 
 from models.errors import ModelError
 from models.fleet.kinematics import DriveLimits, integrate, limit_commands
+from models.navigation.fleet_inputs import packed
 from models.navigation.pure_pursuit import (
     RppParams,
     _arc_distance_py,
-    _config,
     _rpp_py,
     rpp_batch,
 )
@@ -274,7 +274,7 @@ def test_the_compiled_kernel_and_the_python_one_agree():
     poses, vel, limits, radii, carrots, goals, points, start, discs, disc_start, params = args
     state = np.column_stack([poses, vel, radii, carrots, goals])
     out = np.zeros((20, 4))
-    _rpp_py(state, points, start, discs, disc_start, _config(params, limits), out)
+    _rpp_py(state, points, start, discs, disc_start, packed(params, limits), out)
     np.testing.assert_array_equal(out[:, 0], compiled.v)
     np.testing.assert_array_equal(out[:, 1], compiled.w)
     np.testing.assert_array_equal(out[:, 2] > 0.5, compiled.blocked)
