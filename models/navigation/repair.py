@@ -14,11 +14,12 @@ caller replans in full. On the 100 m x 100 m floor a full replan copies and sear
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
-from models.arrays import FloatArray, UInt8Array
+from models.arrays import FloatArray, IntArray, UInt8Array
 from models.errors import ModelError
 from models.navigation.costmap import StaticCostmap, with_obstacles
 from models.navigation.planner import plan, prune_path
@@ -97,6 +98,28 @@ def split_ahead(
     return np.array(stretch), np.array([waypoints[-1]])
 
 
+WindowSearch = Callable[
+    [UInt8Array, tuple[int, int], tuple[int, int], float, "UInt8Array | None", float],
+    "IntArray | None",
+]
+"""A search inside a repair's window: ``(cost, start, goal, resolution_m, lanes, against)``
+to the path's cells ``(k, 2)`` ``ix, iy`` in the window (start first, goal last, corners
+only), or None when it finds none. The window's own costs, lanes and cell coordinates."""
+
+
+def astar_cells(
+    cost: UInt8Array,
+    start: tuple[int, int],
+    goal: tuple[int, int],
+    resolution_m: float,
+    lanes: UInt8Array | None,
+    against: float,
+) -> IntArray | None:
+    """A* in the window (:func:`models.navigation.planner.plan`), pruned to its corners."""
+    result = plan(cost, start, goal, resolution_m=resolution_m, lanes=lanes, against=against)
+    return prune_path(cost, result.cells) if result.found else None
+
+
 def repair_path(
     static: StaticCostmap,
     points_xy: FloatArray,
@@ -108,6 +131,7 @@ def repair_path(
     *,
     lanes: UInt8Array | None = None,
     against: float = 1.0,
+    search: WindowSearch = astar_cells,
 ) -> Repair | None:
     """Replan the stretch of a path ahead of the robot inside a window around it.
 
@@ -122,6 +146,7 @@ def repair_path(
         lanes: optional one-way directions of the grid's cells, as for
             :func:`models.navigation.planner.plan`.
         against: cost factor of a step against a lane.
+        search: the search inside the window (A* by default; a planner plugs in its own).
 
     Returns:
         The repaired path, or None when no path inside the window reaches the cut point
@@ -144,10 +169,10 @@ def repair_path(
     cost = with_obstacles(static, points_xy, discs=discs, window=window)
     local = (s_cell[0] - ix0, s_cell[1] - iy0), (g_cell[0] - ix0, g_cell[1] - iy0)
     window_lanes = None if lanes is None else lanes[iy0:iy1, ix0:ix1]
-    result = plan(cost, local[0], local[1], resolution_m=res, lanes=window_lanes, against=against)
-    if not result.found:
+    found = search(cost, local[0], local[1], res, window_lanes, against)
+    if found is None:
         return None
-    cells = prune_path(cost, result.cells) + np.array([ix0, iy0])
+    cells = found + np.array([ix0, iy0])
     head = origin + (cells + 0.5) * res
     head[-1] = rest[0]
     tail = rest[1:]
@@ -159,4 +184,4 @@ def repair_path(
     return Repair(new, length, window)
 
 
-__all__ = ["Repair", "RepairParams", "repair_path", "split_ahead"]
+__all__ = ["Repair", "RepairParams", "WindowSearch", "astar_cells", "repair_path", "split_ahead"]

@@ -37,10 +37,10 @@ import numpy as np
 
 from models.arrays import FloatArray, IntArray, UInt8Array
 from models.errors import ModelError
-from models.navigation.costmap import INSCRIBED, MAX_NON_OBSTACLE, StaticCostmap, with_obstacles
+from models.navigation.costmap import INSCRIBED, MAX_NON_OBSTACLE, StaticCostmap
 from models.navigation.gridsearch import _F_STEPS, DX, DY, SQRT2, _escapes, escape_r2, readonly
 from models.navigation.planner import _check_cell
-from models.navigation.repair import Repair, RepairParams, split_ahead
+from models.navigation.repair import Repair, RepairParams, repair_path
 
 NO_LANES = readonly(np.zeros((0, 0), dtype=np.uint8))
 """An empty lane grid: no one-way lanes."""
@@ -410,42 +410,43 @@ def repair_theta(
 ) -> Repair | None:
     """The stretch of a path ahead of the robot planned again by Theta*, in a window.
 
-    The stretch, the window round it and the splice with the rest of the path are those
-    of A*'s repair (:func:`models.navigation.repair.repair_path`, same arguments); the
-    search is :func:`theta_star` on the window's costs. None when no path inside the window
-    reaches the cut point (the caller then plans in full).
+    A*'s repair (:func:`models.navigation.repair.repair_path`, same arguments: the stretch,
+    the window round it and the splice with the rest of the path) with :func:`theta_star`
+    as the search in the window. None when no path inside the window reaches the cut point
+    (the caller then plans in full).
     """
-    stretch, rest = split_ahead(waypoints, segment, start_xy, params.ahead_m)
-    res = static.resolution_m
-    corners = np.vstack([stretch, np.asarray(start_xy, dtype=float)[None, :2]])
-    origin = np.asarray(static.origin_xy_m)
-    lo = np.floor((corners.min(axis=0) - params.margin_m - origin) / res).astype(int)
-    hi = np.floor((corners.max(axis=0) + params.margin_m - origin) / res).astype(int) + 1
-    ix0, iy0 = max(int(lo[0]), 0), max(int(lo[1]), 0)
-    ix1, iy1 = min(int(hi[0]), static.width), min(int(hi[1]), static.height)
-    (sx, sy), (gx, gy) = static.world_to_cell(start_xy), static.world_to_cell(rest[0])
-    if not (ix0 <= min(sx, gx) and max(sx, gx) < ix1 and iy0 <= min(sy, gy) and max(sy, gy) < iy1):
-        return None
-    window = (ix0, iy0, ix1, iy1)
-    cost = with_obstacles(static, points_xy, discs=discs, window=window)
-    result = theta_star(
-        cost,
-        (sx - ix0, sy - iy0),
-        (gx - ix0, gy - iy0),
-        cost_weight=cost_weight,
-        resolution_m=res,
-        lanes=None if lanes is None else lanes[iy0:iy1, ix0:ix1],
+
+    def search(
+        cost: UInt8Array,
+        start: tuple[int, int],
+        goal: tuple[int, int],
+        resolution_m: float,
+        window_lanes: UInt8Array | None,
+        against_: float,
+    ) -> IntArray | None:
+        result = theta_star(
+            cost,
+            start,
+            goal,
+            cost_weight=cost_weight,
+            resolution_m=resolution_m,
+            lanes=window_lanes,
+            against=against_,
+        )
+        return result.cells if result.found else None
+
+    return repair_path(
+        static,
+        points_xy,
+        discs,
+        waypoints,
+        segment,
+        start_xy,
+        params,
+        lanes=lanes,
         against=against,
+        search=search,
     )
-    if not result.found:
-        return None
-    head = origin + (result.cells + np.array([ix0, iy0]) + 0.5) * res
-    head[-1] = rest[0]
-    new = np.vstack([head, rest[1:]])
-    # a cut on a waypoint repeats a point: a zero-length segment hides the path ahead
-    new = new[np.r_[True, (np.diff(new, axis=0) != 0).any(axis=1)]]
-    length = float(np.hypot(*np.diff(new, axis=0).T).sum())
-    return Repair(new, length, window)
 
 
 __all__ = [
