@@ -67,7 +67,14 @@ import numpy as np
 from models.arrays import BoolArray, FloatArray, IntArray
 from models.errors import ModelError
 from models.fleet.kinematics import DriveLimits
-from models.navigation.fleet_inputs import check_limits, fleet_rows, offsets, packed, points
+from models.navigation.fleet_inputs import (
+    check_limits,
+    decide_sliced,
+    fleet_rows,
+    offsets,
+    packed,
+    points,
+)
 from models.slicing import Slices, whole
 
 
@@ -362,17 +369,5 @@ def dwa_batch(
     cfg = packed(params, limits)
     out = np.zeros((n, 4))
 
-    def decide(first: int, stop: int) -> None:
-        # the offsets stay absolute: a slice of robots reads its own points and discs
-        _dwa(
-            rows[first:stop],
-            pts,
-            pts_start[first : stop + 1],
-            dsc,
-            dsc_start[first : stop + 1],
-            cfg,
-            out[first:stop],
-        )
-
-    slices(n, decide)
+    decide_sliced(_dwa, slices, rows, pts, pts_start, dsc, dsc_start, cfg, out)
     return DwaResult(out[:, 0].copy(), out[:, 1].copy(), out[:, 2] > 0.5, out[:, 3].copy())

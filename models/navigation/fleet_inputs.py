@@ -18,6 +18,7 @@ import numpy as np
 from models.arrays import FloatArray, IntArray
 from models.errors import ModelError
 from models.fleet.kinematics import DriveLimits
+from models.slicing import Slices
 
 
 def fleet_rows(
@@ -82,3 +83,36 @@ def packed(params: Any, limits: DriveLimits) -> FloatArray:
     between calls: the kernels only read it.
     """
     return np.array(astuple(params) + astuple(limits), dtype=np.float64)
+
+
+def decide_sliced(
+    kernel: Any,
+    slices: Slices,
+    rows: FloatArray,
+    hits: FloatArray,
+    hit_start: IntArray,
+    others: FloatArray,
+    other_start: IntArray,
+    config: FloatArray,
+    out: FloatArray,
+) -> None:
+    """Run a controller's kernel over ``slices`` of the robots, each writing its rows of ``out``.
+
+    The kernel is called as ``kernel(rows, hits, hit_start, others, other_start, config,
+    out)`` on a slice's rows. The offsets stay absolute: a slice of robots reads its own
+    hits and others (discs, neighbours) out of the whole arrays, so each robot's command
+    is the same whatever the cut.
+    """
+
+    def decide(first: int, stop: int) -> None:
+        kernel(
+            rows[first:stop],
+            hits,
+            hit_start[first : stop + 1],
+            others,
+            other_start[first : stop + 1],
+            config,
+            out[first:stop],
+        )
+
+    slices(len(rows), decide)

@@ -66,7 +66,14 @@ from models.arrays import BoolArray, FloatArray, IntArray
 from models.errors import ModelError
 from models.fleet.kinematics import DriveLimits
 from models.geometry.angles import wrap_angle
-from models.navigation.fleet_inputs import check_limits, fleet_rows, offsets, packed, points
+from models.navigation.fleet_inputs import (
+    check_limits,
+    decide_sliced,
+    fleet_rows,
+    offsets,
+    packed,
+    points,
+)
 from models.navigation.orca_lp import det as _det
 from models.navigation.orca_lp import half_plane as _half_plane
 from models.navigation.orca_lp import lp2 as _lp2
@@ -356,17 +363,5 @@ def orca_batch(
     cfg = packed(params, limits)
     out = np.zeros((n, 5))
 
-    def decide(first: int, stop: int) -> None:
-        # the offsets stay absolute: a slice of robots reads its own hits and neighbours
-        _orca(
-            rows[first:stop],
-            pts,
-            pts_start[first : stop + 1],
-            others,
-            oth_start[first : stop + 1],
-            cfg,
-            out[first:stop],
-        )
-
-    slices(n, decide)
+    decide_sliced(_orca, slices, rows, pts, pts_start, others, oth_start, cfg, out)
     return OrcaResult(out[:, 0].copy(), out[:, 1].copy(), out[:, 2] > 0.5, out[:, 3:5].copy())

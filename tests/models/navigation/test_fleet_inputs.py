@@ -12,7 +12,14 @@ from hypothesis import strategies as st
 from models.errors import ModelError
 from models.fleet.kinematics import DriveLimits
 from models.navigation.dwa import DwaParams
-from models.navigation.fleet_inputs import check_limits, fleet_rows, offsets, packed, points
+from models.navigation.fleet_inputs import (
+    check_limits,
+    decide_sliced,
+    fleet_rows,
+    offsets,
+    packed,
+    points,
+)
 
 LIMITS = DriveLimits(1.0, 0.3, 2.0, 2.0, 3.0)
 
@@ -73,3 +80,32 @@ def test_the_packed_parameters_are_the_fields_then_the_limits_built_once():
     vector = packed(DwaParams(), LIMITS)
     assert vector[0] == DwaParams().sim_time_s and vector[-1] == LIMITS.max_yaw_accel_radps2
     assert packed(DwaParams(), LIMITS) is vector  # frozen parameters: built once
+
+
+def test_a_sliced_decision_hands_each_slice_its_rows_and_absolute_offsets():
+    seen = []
+
+    def kernel(rows, hits, hit_start, others, other_start, config, out):
+        seen.append((rows[:, 0].tolist(), hit_start.tolist(), other_start.tolist()))
+        out[:, 0] = rows[:, 0] * 10
+
+    rows = np.arange(3.0).reshape(3, 1)
+    out = np.zeros((3, 1))
+
+    def two_slices(n, decide):
+        decide(0, 2)
+        decide(2, n)
+
+    decide_sliced(
+        kernel,
+        two_slices,
+        rows,
+        np.zeros((4, 2)),
+        np.array([0, 1, 3, 4]),
+        np.zeros((0, 3)),
+        np.zeros(4, dtype=np.int64),
+        np.zeros(1),
+        out,
+    )
+    assert seen == [([0.0, 1.0], [0, 1, 3], [0, 0, 0]), ([2.0], [3, 4], [0, 0])]
+    np.testing.assert_array_equal(out[:, 0], [0.0, 10.0, 20.0])
