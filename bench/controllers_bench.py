@@ -6,7 +6,7 @@ and the robots layer on (the discs and neighbour velocities a reciprocal control
 once per controller, in one process: the controller's wall time per robot and decision
 (``controller_us_per_robot`` of the summary, the ``commands`` call alone), the run's real
 time factor, goals reached and contacts. All controllers are measured in the same command,
-so their ratios hold on a noisy machine; the target is each within 2x of ``dwa``'s budget.
+so their ratios hold on a noisy machine; the target is each within ``dwa``'s budget.
 """
 
 from __future__ import annotations
@@ -55,7 +55,7 @@ def controllers_fleet50(repeat: int) -> Result:
         for row in per.values():
             row["ratio_to_dwa"] = round(row["us_per_robot_median"] / base, 2)
     out["controllers"] = per
-    out["target"] = "each controller's us_per_robot within 2x of dwa's (ratio_to_dwa <= 2)"
+    out["target"] = "each controller's us_per_robot within dwa's (ratio_to_dwa <= 1)"
     return out
 
 

@@ -33,7 +33,7 @@ class TasksConfig:
     station_offset_m: float = param(
         0.25,
         "pick stations: free space between the footprint and the shelf face (m); a robot "
-        "serves a shelf within reach of it",
+        "serves a shelf within reach of it; open tasks stand two footprints plus this apart",
         gt=0,
         le=5.0,
     )

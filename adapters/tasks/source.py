@@ -1,7 +1,10 @@
 """The task source on the base station: tasks appear, are announced, claimed, served, closed.
 
 It opens ``tasks.initial`` tasks at pick stations (shelf faces) at the start and a new one
-whenever one is completed (as in the paper), up to ``tasks.max_total``. The open tasks
+whenever one is completed (as in the paper), up to ``tasks.max_total``. Open tasks stand
+at stations at least two footprints plus ``tasks.station_offset_m`` apart, so that their
+robots never serve in each other's way; a task with no such station left waits for the
+next completion. The open tasks
 are broadcast as a :class:`~cosim.core.messages.TaskSet` over the network whenever they change
 (a new *epoch*) and every ``assignment.rebroadcast_s``. It keeps the book of claims and is
 the one authority on service: a robot at a task asks for the right to serve it, and only
@@ -55,7 +58,7 @@ from cosim.scenario.sections import RobotsConfig, WorldConfig
 from models.fleet.kinematics import FleetState
 from models.navigation.costmap import INSCRIBED, StaticCostmap
 from models.tasks.book import ClaimOutcome, TaskBook, TaskStatus
-from models.tasks.stations import pick_stations
+from models.tasks.stations import clear_of, pick_stations
 from models.world.warehouse import Warehouse
 
 TASKS_TABLE = TableSpec(
@@ -122,6 +125,10 @@ class TaskSourceAdapter:
                 "a shelf face) is free and reachable by the fleet; expected shelves with "
                 "room in front of them (tasks are served at shelves)"
             )
+        self.apart_m = 2.0 * run.settings(RobotsConfig).radius_m + self.cfg.station_offset_m
+        """Least distance between two stations with open tasks (m): two footprints, the space."""
+        self.owed = 0
+        """Tasks not opened for want of a clear station, opened at the next completion."""
         self.central = self.rules.central
         self.rng = run.rng.stream("tasks")
         self.book = TaskBook(
@@ -171,9 +178,10 @@ class TaskSourceAdapter:
         cap = self.cfg.max_total
         if cap and self.next_id >= cap:
             return
-        used = {(t.x_m, t.y_m) for t in self.book.tasks.values() if t.status is not TaskStatus.DONE}
-        free = [k for k, (x, y, _) in enumerate(self.stations) if (x, y) not in used]
-        if not free:
+        used = [(t.x_m, t.y_m) for t in self.book.tasks.values() if t.status is not TaskStatus.DONE]
+        free = np.flatnonzero(clear_of(self.stations, np.array(used), self.apart_m))
+        if not len(free):
+            self.owed += 1
             return
         x, y, _ = self.stations[free[int(self.rng.integers(len(free)))]]
         eligible = frozenset(self._eligible())
@@ -258,7 +266,9 @@ class TaskSourceAdapter:
         if self.book.done(done.task_id, done.robot, now):
             run.recorder.event(now, "task_source", "done", f"task {done.task_id} by {done.robot}")
             self.dirty = True
-            self._create(run)
+            owed, self.owed = self.owed + 1, 0
+            for _ in range(owed):
+                self._create(run)
 
     def _on_report(self, run: RunContext, state: RobotState) -> None:
         self.poses[state.robot] = (state.x_m, state.y_m)
@@ -315,13 +325,12 @@ def _s(t_ns: int) -> float:
 def _reachable_stations(
     run: RunContext, world: Warehouse, static: StaticCostmap, fleet: FleetState
 ) -> np.ndarray:
-    """Pick stations where a robot can stand and that the fleet can reach."""
-    radius = run.settings(RobotsConfig).radius_m
+    """Pick stations where a robot can stand clear of everything and the fleet can reach."""
     stations = pick_stations(
         world.shelves,
-        radius,
+        run.settings(RobotsConfig).radius_m,
         run.settings(TasksConfig).station_offset_m,
-        lambda points: world.is_free(points, radius),
+        world.is_free,
     )
     labels, _ = ndimage.label(static.cost < INSCRIBED, structure=np.ones((3, 3)))
     regions = {

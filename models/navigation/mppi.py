@@ -82,8 +82,8 @@ class MppiParams:
         goal_reset_m: a goal moved farther than this resets the robot's nominal (m).
     """
 
-    samples: int = 48
-    time_steps: int = 15
+    samples: int = 24
+    time_steps: int = 12
     model_dt_s: float = 0.1
     control_period_s: float = 0.1
     v_std_mps: float = 0.2

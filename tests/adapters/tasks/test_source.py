@@ -254,6 +254,30 @@ def test_no_more_tasks_are_created_than_max_total():
     assert s.finish()["tasks_created"] == 2
 
 
+def test_open_tasks_stand_two_footprints_and_the_free_space_apart():
+    s = Source(**{"tasks.initial": 8})
+    s.start()
+    s.until(0.1)
+    spots = np.array([(t.x_m, t.y_m) for t in s.last_set().tasks])
+    apart = 2 * s.scenario.robots.radius_m + s.scenario.tasks.station_offset_m
+    gaps = np.hypot(*(spots[:, None, :] - spots[None, :, :]).transpose(2, 0, 1))
+    assert len(spots) >= 2 and gaps[np.triu_indices(len(spots), 1)].min() >= apart
+
+
+def test_tasks_with_no_clear_station_left_wait_for_the_next_completion():
+    s = Source(**{"tasks.initial": 30})
+    s.start()
+    s.until(0.1)
+    opened = len(s.last_set().tasks)
+    assert opened < 30 and s.source.owed == 30 - opened
+    first = s.last_set().tasks[0].task_id
+    s.at(0.2, SERVICE_REQUESTS, ServiceRequest(0, first, "robot_1"), "robot_1")
+    s.at(0.3, DONE, TaskDone(0, first, "robot_1"), "robot_1")
+    s.until(0.5)
+    # the done task's station is clear again: one of the owed tasks (or its own) opens
+    assert len(s.last_set().tasks) == opened and s.source.owed == 30 - opened
+
+
 def test_every_task_may_be_served_by_at_least_one_robot_whatever_the_eligibility():
     s = Source(**{"tasks.eligibility_prob": 0.05, "tasks.initial": 6})
     s.start()
