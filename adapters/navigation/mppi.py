@@ -29,10 +29,13 @@ _D = MppiParams()
 class MppiSettings:
     """``[mppi]``: samples, horizon, noise and critic weights of the ``mppi`` controller.
 
-    Defaults keep a tick of 50 robots within the time ``dwa`` takes: 24 samples over 12
-    steps of 0.1 s, a 1.2 s horizon (Nav2 samples 2000 over 56 steps of 0.05 s, for one
-    robot; on fleet50, 48 samples over 15 steps took 1.55x ``dwa``'s time and reached as
-    many goals in ``warehouse-humans`` as these defaults, which take 0.84x). Weights are
+    Defaults keep a tick of 50 robots at the time ``dwa`` takes: 24 samples over 12 steps
+    of 0.1 s, a 1.2 s horizon (Nav2 samples 2000 over 56 steps of 0.05 s, for one robot).
+    On fleet50 (runs interleaved with ``dwa``, medians; 2026-11-29) 48 samples over 15
+    steps took 1.55x ``dwa``'s time per robot, these 0.84x and 1.02x in two measurements;
+    20 over 12 (0.87-0.92x) reached 100 goals in ``warehouse-humans`` (8 seeds x 120 s)
+    where these reached 114, and over 10 steps a robot backs up to a goal behind it
+    instead of turning. Weights are
     relative: a sample's cost is their weighted sum of terms of order 1, and
     ``temperature`` is in the same units.
     """
