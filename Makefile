@@ -10,7 +10,7 @@ ARGS   ?=
 STUDIES := runs/studies
 STUDY = $(BIN)/cosim study studies/$(1).toml --out $(STUDIES)/$(1) --resume
 
-.PHONY: setup demo test test-fast docs lint bench bench-peers clean help reproduce study-comm study-comm-reduced \
+.PHONY: setup ns3 demo test test-fast docs lint bench bench-peers clean help reproduce study-comm study-comm-reduced \
 	study-burst study-scale study-paper study-nav study-mapping study-mapping-reduced \
 	study-mapping-acceptance study-mapping-defaults study-mapping-drift map-aces map-fr079 \
 	lab-real lab-mixed study-humans study-humans-reduced study-humans-contacts study-traffic \
@@ -31,11 +31,20 @@ $(STAMP): pyproject.toml
 # to each module), so that the first `make demo` shows the real speed
 setup: $(STAMP)  ## create .venv, install cosim with its dev tools, compile the numba kernels
 
+# ns-3's Python bindings for network.backend = "ns3" (the `ns3` extra): `make test` runs the
+# radio for real, so it installs them (cppyy is built from source: about 2 min, 600 MB)
+NS3_STAMP := $(VENV)/.installed-ns3
+$(NS3_STAMP): $(STAMP)
+	$(BIN)/python -m pip install --quiet -e '.[dev,ns3]'
+	touch $(NS3_STAMP)
+
+ns3: $(NS3_STAMP)  ## install the ns3 extra (network.backend = "ns3") into .venv
+
 # ARGS: more arguments of the run of demo, lab-real and lab-mixed (ARGS='--seed 3 --duration-s 30')
 demo: setup  ## run the default scenario and say where the results are
 	$(BIN)/cosim run $(SCENARIO) --out $(OUT) --force $(ARGS)
 
-test: setup docs  ## the documentation build and the whole test suite, on every core (CI runs this)
+test: setup ns3 docs  ## the documentation build and the whole test suite, on every core (CI runs this)
 	$(BIN)/python -m pytest -q -n auto
 
 test-fast: setup  ## all but the slow tests (whole runs, SUMO, DDS, Dask, real time), on every core

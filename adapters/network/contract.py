@@ -35,7 +35,7 @@ from typing import Any, ClassVar, Protocol
 from adapters.network.settings import NetworkConfig
 from cosim.core.adapter import RunContext
 from cosim.core.hosts import HostId
-from cosim.core.link import AllDelivered, Transfer
+from cosim.core.link import AllDelivered, Later, Transfer
 from cosim.core.registry import Group
 from cosim.core.table import TableSpec
 from models.network.latency import LatencyModel
@@ -84,7 +84,7 @@ class NetworkBackend(Protocol):
 
     def transmit(
         self, t_ns: int, src: HostId, dsts: Sequence[HostId], nbytes: int, topic: str
-    ) -> Sequence[Transfer] | AllDelivered:
+    ) -> Sequence[Transfer] | AllDelivered | Later:
         """The fate of one transmission towards every destination host (see ``Link``)."""
         ...
 

@@ -37,3 +37,12 @@ class NetworkAdapter:
     def finish(self, run: RunContext) -> Mapping[str, Any]:
         """The backend's summary."""
         return self.backend.finish(run)
+
+    def close(self) -> None:
+        """Let the backend release what it holds (a radio's process), if it holds any.
+
+        Called however the run ended, before :meth:`finish` when it ended well.
+        """
+        close = getattr(self.backend, "close", None)
+        if callable(close):
+            close()

@@ -28,7 +28,7 @@ import simpy
 
 from cosim.core.hosts import HostId
 from cosim.core.kernel import Kernel, Stage
-from cosim.core.link import DELIVERED, AllDelivered, IdealLink, Link, Transfer
+from cosim.core.link import DELIVERED, AllDelivered, IdealLink, Later, Link, Transfer
 from cosim.core.messages import Message
 from cosim.core.plugins import PluginError
 
@@ -143,6 +143,8 @@ class Bus:
         self._routes: dict[tuple[str, HostId], Route] = {}
         self._monitors: dict[str, list[Monitor]] = {}
         self._advertised: dict[str, Advertisement] = {}
+        self._later: dict[int, tuple[str, Message, HostId, int, int, tuple[HostId, ...]]] = {}
+        """Transmissions whose fate the link tells later, by ticket."""
         self.published = 0
 
     def advertise(
@@ -283,6 +285,11 @@ class Bus:
         """
         outcome = self.link.transmit(t_sent_ns, src, remote, nbytes, topic)
         arrivals: dict[int, list[HostId]]
+        if isinstance(outcome, Later):
+            if outcome.ticket in self._later:
+                raise ValueError(f"link gave ticket {outcome.ticket} to two transmissions")
+            self._later[outcome.ticket] = (topic, message, src, t_sent_ns, nbytes, remote)
+            return
         if isinstance(outcome, AllDelivered):
             # every copy at one instant: the transfers it stands for, without building them
             t_recv_ns = outcome.t_recv_ns
@@ -294,7 +301,49 @@ class Bus:
             arrivals = {t_recv_ns: list(remote)}
         else:
             arrivals = self._arrivals(t_sent_ns, src, topic, nbytes, outcome)
+        self._schedule(topic, message, src, t_sent_ns, arrivals)
+
+    def settle(self, ticket: int, transfers: Sequence[Transfer]) -> None:
+        """The fate of a transmission the link answered :class:`~cosim.core.link.Later` to.
+
+        One :class:`Transfer` per destination host, in the order the link was given them.
+        Copies whose arrival time is already past are delivered now, the others when they
+        arrive; the tap records the link's arrival times.
+
+        Raises:
+            ValueError: for a ticket not pending, or transfers that do not match its hosts.
+        """
+        pending = self._later.pop(ticket, None)
+        if pending is None:
+            raise ValueError(f"no transmission is waiting for ticket {ticket}")
+        topic, message, src, t_sent_ns, nbytes, remote = pending
+        if tuple(t.dst for t in transfers) != remote:
+            raise ValueError(
+                f"ticket {ticket} ({topic}) went to {list(remote)}; the link settled it for "
+                f"{[t.dst for t in transfers]}"
+            )
+        now = int(self.kernel.env.now)
+        arrivals = self._arrivals(t_sent_ns, src, topic, nbytes, transfers)
+        due: dict[int, list[HostId]] = {}
+        for t_recv_ns, hosts in arrivals.items():
+            due.setdefault(max(t_recv_ns, now), []).extend(hosts)
+        self._schedule(topic, message, src, t_sent_ns, due)
+
+    def unsettled(self) -> int:
+        """How many transmissions still wait for the link to tell their fate."""
+        return len(self._later)
+
+    def _schedule(
+        self,
+        topic: str,
+        message: Message,
+        src: HostId,
+        t_sent_ns: int,
+        arrivals: dict[int, list[HostId]],
+    ) -> None:
+        """Deliver ``message`` to each host at its arrival time (ns), one event per instant."""
         by_host = self._topics[topic]
+        now = int(self.kernel.env.now)
         for t_recv_ns, hosts in arrivals.items():
             envelope = Envelope(topic, src, t_sent_ns, t_recv_ns)
 
@@ -306,8 +355,7 @@ class Bus:
                     for callback in tuple(by_host.get(dst, ())):
                         callback(message, envelope)
 
-            delay = t_recv_ns - t_sent_ns
-            self.kernel.timeout(delay, Stage.DELIVERY).callbacks.append(deliver)
+            self.kernel.timeout(t_recv_ns - now, Stage.DELIVERY).callbacks.append(deliver)
 
     def _arrivals(
         self,

@@ -50,17 +50,36 @@ class AllDelivered:
     t_recv_ns: int
 
 
+@dataclass(frozen=True, slots=True)
+class Later:
+    """Outcome of a transmission whose fate the link tells later.
+
+    A link that must see what else is on the air before it can tell (a radio simulator
+    stepping in windows) returns this and, once it knows, calls
+    :meth:`cosim.core.bus.Bus.settle` with the same ``ticket`` and a :class:`Transfer` per
+    destination, in order. Copies whose arrival time has passed by then are delivered at
+    once (the link's window is the most they are late by); the tap records the link's own
+    arrival times.
+
+    Attributes:
+        ticket: the link's id of this transmission, unique among those not settled yet.
+    """
+
+    ticket: int
+
+
 class Link(Protocol):
     """Decides the fate of messages between hosts."""
 
     def transmit(
         self, t_ns: int, src: HostId, dsts: Sequence[HostId], nbytes: int, topic: str
-    ) -> Sequence[Transfer] | AllDelivered:
+    ) -> Sequence[Transfer] | AllDelivered | Later:
         """Send one message of ``nbytes`` from ``src`` at ``t_ns`` to every host in ``dsts``.
 
         One call is one transmission: a broadcast reaches several hosts with independent
         fates, a :class:`Transfer` each in the order of ``dsts`` (or :class:`AllDelivered`
-        when every copy arrives at one instant). Arrival times must not lie before ``t_ns``.
+        when every copy arrives at one instant, or :class:`Later` when the link tells the
+        bus afterwards). Arrival times must not lie before ``t_ns``.
         """
         ...
 

@@ -32,6 +32,8 @@ VOLATILE_METRICS = (
     "thread_busy",
     "controller_ms_per_tick",
     "controller_us_per_robot",
+    "radio_wall_s",
+    "radio_start_s",
 )
 """Summary entries that depend on the machine or executor, not on the scenario and seed."""
 

@@ -85,9 +85,9 @@ def test_a_value_out_of_bounds_is_refused_naming_the_key_the_value_and_the_bound
 
 def test_an_unknown_backend_is_refused_with_the_registered_ones():
     with pytest.raises(ConfigError) as refused:
-        _load(**{"network.backend": "ns3"})
+        _load(**{"network.backend": "omnet"})
     message = str(refused.value)
-    assert "backend = 'ns3': expected a registered network backend" in message
+    assert "backend = 'omnet': expected a registered network backend" in message
     assert "(registered: links" in message
 
 

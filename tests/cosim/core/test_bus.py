@@ -7,7 +7,7 @@ import pytest
 from cosim.core.bus import Bus, Envelope
 from cosim.core.hosts import HostId
 from cosim.core.kernel import Kernel, Stage
-from cosim.core.link import AllDelivered, Transfer
+from cosim.core.link import AllDelivered, Later, Transfer
 from cosim.core.messages import Message, Twist
 from cosim.core.recorder import Recorder
 from cosim.core.timebase import period_ns
@@ -439,3 +439,58 @@ def test_a_plugin_publishing_the_wrong_type_in_a_run_is_refused_from_its_own_cal
     frames = [frame for frame, _ in traceback.walk_tb(caught.value.__cause__.__traceback__)]
     assert [f.f_code.co_name for f in frames[-2:]] == ["publish", "publish_many"]
     assert frames[-3].f_globals["__name__"] == __name__
+
+
+class WindowLink:
+    """A test link that tells every fate later, as a radio simulator stepping in windows."""
+
+    def __init__(self) -> None:
+        self.waiting: list[tuple[int, int, tuple[HostId, ...]]] = []
+
+    def transmit(
+        self, t_ns: int, src: HostId, dsts: Sequence[HostId], nbytes: int, topic: str
+    ) -> Later:
+        self.waiting.append((len(self.waiting), t_ns, tuple(dsts)))
+        return Later(len(self.waiting) - 1)
+
+
+def test_a_fate_told_later_is_delivered_at_its_time_or_at_once_if_that_has_passed():
+    kernel = Kernel()
+    link = WindowLink()
+    recorder = Recorder()
+    bus = Bus(kernel, link, recorder)
+    got: list[tuple[int, Message, Envelope]] = []
+    bus.subscribe("/x", B, _collect(got, kernel))
+    bus.subscribe("/x", C, _collect(got, kernel))
+    kernel.at(10_000_000, lambda: bus.publish("/x", Twist(1.0, 0.0), A))
+    kernel.at(20_000_000, lambda: bus.publish("/x", Twist(2.0, 0.0), A))
+
+    def window_end() -> None:  # at 50 ms the link knows: one copy arrived at 12 ms, one will
+        assert bus.unsettled() == 2
+        bus.settle(0, [Transfer(B, "delivered", 12_000_000), Transfer(C, "lost", None)])
+        bus.settle(1, [Transfer(B, "delivered", 70_000_000), Transfer(C, "delivered", 21_000_000)])
+
+    kernel.at(50_000_000, window_end)
+    kernel.run(100_000_000)
+    assert [(t, m.linear_x_mps, e.t_sent_ns, e.t_recv_ns) for t, m, e in got] == [
+        (50_000_000, 1.0, 10_000_000, 50_000_000),
+        (50_000_000, 2.0, 20_000_000, 50_000_000),
+        (70_000_000, 2.0, 20_000_000, 70_000_000),
+    ]
+    assert bus.unsettled() == 0
+    rows = messages_frame(recorder)
+    # the tap keeps the link's own arrival times
+    assert sorted(rows.t_recv_s.dropna().round(3)) == [0.012, 0.021, 0.07]
+    assert (rows.status == "lost").sum() == 1
+
+
+def test_settling_an_unknown_ticket_or_other_hosts_is_refused():
+    kernel = Kernel()
+    bus = Bus(kernel, WindowLink())
+    bus.subscribe("/x", B, lambda m, e: None)
+    kernel.at(0, lambda: bus.publish("/x", Twist(1.0, 0.0), A))
+    kernel.run(1)
+    with pytest.raises(ValueError, match="ticket 5"):
+        bus.settle(5, [])
+    with pytest.raises(ValueError, match="settled it for"):
+        bus.settle(0, [Transfer(C, "delivered", 1)])

@@ -1,0 +1,44 @@
+import numpy as np
+from hypothesis import given
+from hypothesis import strategies as st
+from shapely.geometry import LineString, box
+
+from models.network.shadowing import boxes_crossed
+
+SHELVES = np.array([[2.0, 0.0, 3.0, 4.0], [5.0, 0.0, 6.0, 4.0], [0.0, 6.0, 8.0, 6.5]])
+
+
+def test_a_line_across_two_shelves_meets_two_and_one_beside_them_none():
+    a = np.array([[0.0, 2.0], [0.0, 5.0], [4.0, 1.0]])
+    b = np.array([[8.0, 2.0], [8.0, 5.0], [4.0, 8.0]])
+    assert boxes_crossed(a, b, SHELVES).tolist() == [2, 0, 1]
+
+
+def test_touching_a_corner_and_ending_inside_count_and_stopping_short_does_not():
+    a = np.array([[1.0, 5.0], [1.0, 2.0], [1.0, 2.0]])
+    b = np.array([[3.0, 3.0], [2.5, 2.0], [1.9, 2.0]])
+    # (1, 5) -> (3, 3) passes (2, 4), the first shelf's corner
+    assert boxes_crossed(a, b, SHELVES).tolist() == [1, 1, 0]
+
+
+def test_axis_parallel_lines_inside_and_outside_a_slab():
+    a = np.array([[2.5, -1.0], [1.0, -1.0]])
+    b = np.array([[2.5, 10.0], [1.0, 10.0]])
+    assert boxes_crossed(a, b, SHELVES).tolist() == [2, 1]  # both cross the long one
+
+
+coord = st.floats(-1.0, 9.0, allow_nan=False)
+
+
+@given(st.lists(st.tuples(coord, coord, coord, coord), min_size=1, max_size=20))
+def test_it_agrees_with_shapely_on_any_segment(segments):
+    seg = np.array(segments)
+    got = boxes_crossed(seg[:, :2], seg[:, 2:], SHELVES)
+    boxes = [box(*s) for s in SHELVES]
+    for (x0, y0, x1, y1), n in zip(segments, got, strict=True):
+        line = LineString([(x0, y0), (x1, y1)]) if (x0, y0) != (x1, y1) else None
+        if line is None:
+            want = sum(b.intersects(LineString([(x0, y0), (x0, y0 + 1e-12)])) for b in boxes)
+        else:
+            want = sum(b.intersects(line) for b in boxes)
+        assert n == want, ((x0, y0, x1, y1), n, want)
