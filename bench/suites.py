@@ -18,6 +18,7 @@ from landmarks_bench import landmark_savings
 from lidar_bench import lidar_rays_per_second
 from mapping_bench import fleet50_mapping, per_scan_costs, recordings_mapping
 from network_bench import network_deliveries_per_second
+from ns3_bench import ns3_radio
 from peers_bench import irsim_peer
 from planner_bench import planner_ms
 from recording_bench import bag_cost, bag_memory_1h, encoding
@@ -413,6 +414,7 @@ SUITES: dict[str, Callable[[int], Result]] = {
     "lidar": lidar,
     "network": network_deliveries_per_second,
     "network_end_to_end": network_end_to_end,
+    "ns3_radio": ns3_radio,
     "planner": planner_ms,
     "fleet50_navigation": fleet50_navigation,
     "fleet50_full_stack": fleet50_full_stack,

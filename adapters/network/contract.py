@@ -125,6 +125,31 @@ NETWORK_BACKENDS = Group(
 """Network backends (``network.backend``): what decides if and when messages arrive."""
 
 
+class RadioView:
+    """What each host's radio last measured of each sender (a service of a radio backend).
+
+    A backend that simulates radios (``ns3``) offers it to the run: a protocol may read the
+    signal a host received a sender's last message with, as a robot's driver reports it,
+    and weigh links by it. Values change when a copy is delivered, not before.
+    """
+
+    def __init__(self) -> None:
+        self._last: dict[tuple[str, str], tuple[int, float, float]] = {}
+
+    def heard(self, host: str, sender: str, t_ns: int, rssi_dbm: float, snr_db: float) -> None:
+        """``host`` received a message of ``sender`` at ``t_ns`` with this signal and SNR."""
+        self._last[(host, sender)] = (t_ns, rssi_dbm, snr_db)
+
+    def rssi_dbm(self, host: str, sender: str) -> float | None:
+        """The signal (dBm) ``host`` last received ``sender`` with; None: never heard it."""
+        last = self._last.get((host, sender))
+        return None if last is None else last[1]
+
+    def last(self, host: str, sender: str) -> tuple[int, float, float] | None:
+        """When (ns), with what signal (dBm) and SNR (dB) ``host`` last heard ``sender``."""
+        return self._last.get((host, sender))
+
+
 class NetworkView:
     """Who can hear whom, now, as the run's backend says (a service of the run).
 

@@ -42,7 +42,9 @@ from models.errors import ModelError
 from models.fleet.kinematics import FleetState
 from models.network.model import LinkParams, NetworkModel, Partition
 from models.network.radio import PathLoss
+from models.network.shadowing import boxes_crossed
 from models.network.topology import Edges, edge
+from models.world.warehouse import Warehouse
 
 T = TypeVar("T")
 
@@ -94,6 +96,7 @@ def build_model(context: NetworkContext, partitions: list[Partition]) -> Network
             exponent=cfg.path_loss_exponent,
             sensitivity_dbm=cfg.sensitivity_dbm,
             shadowing_db=cfg.shadowing_db,
+            wall_loss_db=cfg.wall_loss_db,
         )
     params = LinkParams(
         latency=latency.model(),
@@ -175,6 +178,7 @@ class LinksBackend(ModelLink):
         "latency_csv", "reorder", "loss_model", "loss_prob", "ge_p", "ge_r", "ge_loss_bad",
         "ge_loss_good", "bandwidth_mbps", "queue_packets", "range_m", "path_loss",
         "path_loss_exponent", "tx_power_dbm", "ref_loss_db", "sensitivity_dbm", "shadowing_db",
+        "wall_loss_db",
         "topology_update_hz", "partitions",
     )  # fmt: skip
     """The ``[network]`` keys only this backend reads (another backend leaves them unset)."""
@@ -188,6 +192,9 @@ class LinksBackend(ModelLink):
         self.partitions: list[Partition] = partitions_of(cfg)
         model = _checked(self.source, lambda: build_model(context, self.partitions))
         super().__init__(model, self._distance_m)
+        if cfg.path_loss and cfg.wall_loss_db > 0:
+            self.boxes = np.asarray(run.service(Warehouse).inner_boxes, dtype=float).reshape(-1, 4)
+            model.walls_between = self._walls_between
         choice: TopologyChoice = TOPOLOGIES.installed().get(cfg.topology)(context)
         self.topology = _checked(self.source, choice.edges)
         self.range_m = cfg.range_m if cfg.range_m > 0 else None
@@ -204,6 +211,15 @@ class LinksBackend(ModelLink):
             return None
         fleet = self.fleet
         return float(np.hypot(fleet.x[i] - fleet.x[j], fleet.y[i] - fleet.y[j]))
+
+    def _walls_between(self, a: str, b: str) -> int:
+        """Walls, shelves and obstacles the straight line between two robots meets."""
+        i, j = self._index.get(a), self._index.get(b)
+        if i is None or j is None:
+            return 0
+        fleet = self.fleet
+        ends = np.array([[fleet.x[i], fleet.y[i]]]), np.array([[fleet.x[j], fleet.y[j]]])
+        return int(boxes_crossed(*ends, self.boxes)[0])
 
     def _check_partition_hosts(self, run: RunContext) -> None:
         known = set(run.hosts)

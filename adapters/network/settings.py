@@ -174,6 +174,13 @@ class NetworkConfig:
     )
     sensitivity_dbm: float = param(-82.0, "receiver sensitivity (dBm)")
     shadowing_db: float = param(4.0, "log-normal shadowing deviation (dB)", ge=0)
+    wall_loss_db: float = param(
+        0.0,
+        "path loss: loss for every wall, shelf or obstacle the straight line between two "
+        "robots meets (dB; COST 231's multi-wall model); 0: line of sight ignored",
+        ge=0,
+        le=100,
+    )
     topology_update_hz: float = param(10.0, "rate of link up/down updates (Hz)", gt=0, le=1000)
     partitions: tuple[PartitionConfig, ...] = param((), "scheduled outages")
 
@@ -181,3 +188,5 @@ class NetworkConfig:
         """What the chosen models cannot run with, and keys only unchosen ones read."""
         for key in ("backend", "latency_model", "loss_model", "topology"):
             yield from choice_problems(self, key)
+        if self.wall_loss_db > 0 and not self.path_loss:
+            yield Problem("wall_loss_db", self.wall_loss_db, "0 unless path_loss = true")

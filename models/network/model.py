@@ -176,6 +176,9 @@ class NetworkModel:
         self._queues: dict[str, InterfaceQueue] = {}
         self._links: dict[tuple[str, str], _Link] = {}
         self._ideal_ns = _ideal_latency_ns(params, bandwidth_bps, self.partitions)
+        self.walls_between: Callable[[str, str], int] | None = None
+        """How many walls stand between two hosts now, for the path loss's wall loss (None:
+        none anywhere). Set by whoever knows where the hosts and walls are."""
 
     @property
     def edges(self) -> Edges | None:
@@ -293,7 +296,8 @@ class NetworkModel:
                         out.append((dst, _OUT_OF_RANGE, None))
                         continue
                     if path_loss is not None:
-                        received = link.u_recv[i] < path_loss.reception_probability_at(d)
+                        walls = 0 if self.walls_between is None else self.walls_between(src, dst)
+                        received = link.u_recv[i] < path_loss.reception_probability_at(d, walls)
             if link.loss.lost(link.u_tr[i], link.u_loss[i]) or not received:
                 out.append((dst, _LOST, None))
                 continue

@@ -63,6 +63,9 @@ class PathLoss:
         sensitivity_dbm: the weakest received power that is decoded (dBm).
         shadowing_db: standard deviation of the shadowing (dB, >= 0); 0 makes reception
             a step at the distance where the mean RSSI meets the sensitivity.
+        wall_loss_db: loss for every wall, shelf or obstacle between the two ends (dB,
+            >= 0): the multi-wall model of COST 231 (a constant loss per wall on top of
+            the distance loss), walls counted by :func:`models.network.shadowing.boxes_crossed`.
     """
 
     tx_power_dbm: float = 20.0
@@ -70,6 +73,7 @@ class PathLoss:
     exponent: float = 3.0
     sensitivity_dbm: float = -82.0
     shadowing_db: float = 4.0
+    wall_loss_db: float = 0.0
 
     def __post_init__(self) -> None:
         for key, value in (
@@ -83,6 +87,8 @@ class PathLoss:
             raise ModelError("network.path_loss_exponent", self.exponent, "a number > 0")
         if not (math.isfinite(self.shadowing_db) and self.shadowing_db >= 0.0):
             raise ModelError("network.shadowing_db", self.shadowing_db, "a number of dB >= 0")
+        if not (math.isfinite(self.wall_loss_db) and self.wall_loss_db >= 0.0):
+            raise ModelError("network.wall_loss_db", self.wall_loss_db, "a number of dB >= 0")
 
     @property
     def margin_db(self) -> float:
@@ -102,10 +108,10 @@ class PathLoss:
             return (excess >= 0.0).astype(np.float64)
         return np.asarray(ndtr(excess / self.shadowing_db), dtype=np.float64)
 
-    def reception_probability_at(self, d_m: float) -> float:
-        """:meth:`reception_probability` for one distance, with scalar math (no numpy)."""
+    def reception_probability_at(self, d_m: float, walls: int = 0) -> float:
+        """:meth:`reception_probability` for one distance and ``walls`` walls in between."""
         d = d_m if d_m > REFERENCE_DISTANCE_M else REFERENCE_DISTANCE_M
-        excess = self.margin_db - 10.0 * self.exponent * math.log10(d)
+        excess = self.margin_db - 10.0 * self.exponent * math.log10(d) - self.wall_loss_db * walls
         if self.shadowing_db == 0.0:
             return 1.0 if excess >= 0.0 else 0.0
         return 0.5 * math.erfc(-excess / (self.shadowing_db * math.sqrt(2.0)))

@@ -5,7 +5,9 @@ standard, rate, power, path loss, fading, detection threshold, a loss per wall, 
 obstacle in between). A message a radio node publishes to other hosts is one UDP broadcast
 of its real size (fragmented by ns-3 when larger than a frame), on the air at its exact time
 plus the send jitter of its host (``ns3.send_jitter_ms``, seeded); each destination gets it
-if its node received every fragment, at the time it did.
+if its node received every fragment, at the time it did. What each host's radio measured
+of each sender's last message is offered to protocols
+(:class:`~adapters.network.contract.RadioView`).
 
 The radio runs in a process of its own (:mod:`adapters.network.ns3.process`), in lockstep
 with the kernel: every ``ns3.window_ms`` the backend hands it the robots' positions and
@@ -31,7 +33,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from adapters.network.contract import NetworkContext
+from adapters.network.contract import NetworkContext, RadioView
 from adapters.network.ns3.process import RadioProcess
 from adapters.network.ns3.settings import Ns3Settings
 from adapters.network.ns3.wire import DROP_DTYPE, RX_DTYPE
@@ -127,6 +129,8 @@ class Ns3Backend:
         self.jitter_ns = round(self.cfg.send_jitter_ms * 1e6)
         self.rng = run.rng.stream("ns3/jitter")
         self.table = run.recorder.table(RADIO)
+        self.view = RadioView()
+        run.provide(self.view)
         self.bus: Any = None
         self.process: RadioProcess | None = None
         self.next_ticket = 0
@@ -233,6 +237,7 @@ class Ns3Backend:
             for dst in dsts:
                 if dst in got:
                     t_rx, rssi, snr = got[dst]
+                    self.view.heard(dst, src, max(t_rx, now_ns), rssi, snr)
                     transfers.append(Transfer(dst, DELIVERED, t_rx))
                     rows.append((dst, t_rx / NS_PER_S, DELIVERED, rssi, snr))
                 elif dst not in self.node:  # a wired host hears the base station at once

@@ -256,3 +256,39 @@ def test_the_link_over_an_ideal_network_stands_for_the_transfers_of_its_links():
         each = [Transfer(d, DeliveryStatus.DELIVERED, outcome.t_recv_ns) for d in dsts]
         assert each == forced.transmit(k * 1_000, src, dsts, 100, "/t")
     assert list(fast.latencies_ns) == list(forced.latencies_ns) == [3_000_000] * 79
+
+
+def test_walls_between_two_robots_cost_reception_with_the_wall_loss_set():
+    # two robots 20 m apart with two walls between them: 20 dBm - 46.7 - 39 dB leaves a
+    # 16 dB margin over -82 dBm; two 10 dB walls put it 4 dB under
+    import cosim
+    from cosim.runner.assembly import assemble
+
+    base = {
+        "world.size_m": [40.0, 10.0],
+        "world.shelf_count": 0,
+        "world.obstacles": [[14.0, 0.0, 15.0, 7.0], [20.0, 0.0, 21.0, 7.0]],
+        "robots.count": 2,
+        "robots.placement": "explicit",
+        "robots.positions": [[5.0, 3.0, 0.0], [25.0, 3.0, 0.0]],
+        "network.path_loss": True,
+        "network.shadowing_db": 0.0,
+    }
+    for loss, heard in ((0.0, True), (10.0, False)):
+        run = assemble(
+            cosim.load_scenario("warehouse-random", {**base, "network.wall_loss_db": loss}),
+            names=["network"],
+        ).run
+        backend = run.bus.link
+        outcome = backend.transmit(0, "robot_1", ["robot_2"], 100, "/x")
+        assert (outcome[0].status == "delivered") is heard, (loss, outcome)
+
+
+def test_a_wall_loss_without_the_path_loss_is_refused():
+    import pytest
+
+    import cosim
+    from cosim.core.errors import ConfigError
+
+    with pytest.raises(ConfigError, match="wall_loss_db"):
+        cosim.load_scenario("warehouse-random", {"network.wall_loss_db": 10.0})

@@ -74,8 +74,20 @@ def _run(tmp: Path, name: str, overrides: dict[str, Any]) -> cosim.RunResult:
 
 
 @pytest.mark.slow
-def test_delivery_falls_with_distance_and_with_a_wall_in_between(tmp_path):
+def test_delivery_falls_with_distance_and_with_a_wall_in_between(tmp_path, monkeypatch):
+    views = []
+    start = ns3_backend.Ns3Backend.start
+
+    def keep_view(self, run):
+        views.append(self.view)
+        start(self, run)
+
+    monkeypatch.setattr(ns3_backend.Ns3Backend, "start", keep_view)
     radio = _run(tmp_path, "room", ROOM).tables["radio"]
+    # what a protocol reads: the signal robot_2 last heard robot_1 with, never robot_5
+    [view] = views
+    assert view.rssi_dbm("robot_2", "robot_1") == pytest.approx(-66.4, abs=1.0)
+    assert view.rssi_dbm("robot_5", "robot_1") is None
     heard = (
         radio[radio.src == "robot_1"]
         .groupby("dst", observed=True)
