@@ -112,6 +112,7 @@ def build_model(context: NetworkContext, partitions: list[Partition]) -> Network
         bandwidth_bps=bandwidth,
         queue_packets=cfg.queue_packets,
         partitions=partitions,
+        airtime_bps=cfg.airtime_mbps * 1e6 if cfg.airtime_mbps > 0 else None,
     )
 
 
@@ -178,7 +179,7 @@ class LinksBackend(ModelLink):
         "latency_csv", "reorder", "loss_model", "loss_prob", "ge_p", "ge_r", "ge_loss_bad",
         "ge_loss_good", "bandwidth_mbps", "queue_packets", "range_m", "path_loss",
         "path_loss_exponent", "tx_power_dbm", "ref_loss_db", "sensitivity_dbm", "shadowing_db",
-        "wall_loss_db",
+        "wall_loss_db", "airtime_mbps",
         "topology_update_hz", "partitions",
     )  # fmt: skip
     """The ``[network]`` keys only this backend reads (another backend leaves them unset)."""

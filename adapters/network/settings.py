@@ -174,6 +174,14 @@ class NetworkConfig:
     )
     sensitivity_dbm: float = param(-82.0, "receiver sensitivity (dBm)")
     shadowing_db: float = param(4.0, "log-normal shadowing deviation (dB)", ge=0)
+    airtime_mbps: float = param(
+        0.0,
+        "the rate of one radio channel every host shares (Mbit/s): each message takes its "
+        "turn on it with its headers and the 802.11g frame overheads, so latency grows with "
+        "how many robots send how many bytes; 0: none (each host's bandwidth_mbps instead)",
+        ge=0,
+        le=10_000,
+    )
     wall_loss_db: float = param(
         0.0,
         "path loss: loss for every wall, shelf or obstacle the straight line between two "
@@ -188,5 +196,11 @@ class NetworkConfig:
         """What the chosen models cannot run with, and keys only unchosen ones read."""
         for key in ("backend", "latency_model", "loss_model", "topology"):
             yield from choice_problems(self, key)
+        if self.airtime_mbps > 0 and self.bandwidth_mbps > 0:
+            yield Problem(
+                "bandwidth_mbps",
+                self.bandwidth_mbps,
+                "0 with airtime_mbps set (the shared channel serializes every host's messages)",
+            )
         if self.wall_loss_db > 0 and not self.path_loss:
             yield Problem("wall_loss_db", self.wall_loss_db, "0 unless path_loss = true")

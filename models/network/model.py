@@ -30,6 +30,7 @@ sweeps). The loss process is advanced once for every message that reaches stage 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -141,6 +142,16 @@ class _Link:
         self.i = 0
 
 
+FRAME_OVERHEAD_BYTES = 64
+"""Headers a message carries on the air (bytes): 802.11 MAC header and FCS (28), LLC/SNAP
+(8), IPv4 (20) and UDP (8)."""
+
+FRAME_OVERHEAD_NS = 115_500
+"""Time a frame holds the air beyond its bytes (ns), 802.11g OFDM: DIFS (28 us), the mean
+backoff of an idle channel (CWmin 15 slots of 9 us, halved: 67.5 us) and the preamble and
+PLCP header (20 us) (IEEE 802.11-2016, 17.4.4 and 18.4.6)."""
+
+
 class NetworkModel:
     """Decides the fate and arrival time of every inter-host message.
 
@@ -152,6 +163,11 @@ class NetworkModel:
         queue_packets: how many messages may wait in a host's interface (see
             :class:`~models.network.interface.InterfaceQueue`).
         partitions: scheduled partitions.
+        airtime_bps: the rate of one channel every host shares (bit/s), ``None`` for none:
+            each message then takes its turn on it, first come first served, for its bytes
+            plus :data:`FRAME_OVERHEAD_BYTES` and :data:`FRAME_OVERHEAD_NS` (instead of each
+            host's own interface: the two are not combined), so that latency grows with
+            how many robots send how many bytes.
 
     Raises:
         ModelError: for a bad bandwidth or queue limit.
@@ -165,8 +181,19 @@ class NetworkModel:
         bandwidth_bps: float | None,
         queue_packets: int,
         partitions: Sequence[Partition] = (),
+        airtime_bps: float | None = None,
     ) -> None:
         InterfaceQueue(bandwidth_bps, queue_packets)  # validate now, not at the first send
+        if airtime_bps is not None and bandwidth_bps is not None:
+            raise ModelError(
+                "network.bandwidth_mbps", bandwidth_bps / 1e6, "0 with airtime_mbps set"
+            )
+        self._air = None if airtime_bps is None else InterfaceQueue(airtime_bps, queue_packets)
+        self._air_extra = (
+            0
+            if airtime_bps is None
+            else (FRAME_OVERHEAD_BYTES + math.ceil(FRAME_OVERHEAD_NS * airtime_bps / 8e9))
+        )
         self.params = params
         self.bandwidth_bps = bandwidth_bps
         self.queue_packets = queue_packets
@@ -175,7 +202,9 @@ class NetworkModel:
         self._edges: Edges | None = None
         self._queues: dict[str, InterfaceQueue] = {}
         self._links: dict[tuple[str, str], _Link] = {}
-        self._ideal_ns = _ideal_latency_ns(params, bandwidth_bps, self.partitions)
+        self._ideal_ns = (
+            _ideal_latency_ns(params, bandwidth_bps, self.partitions) if self._air is None else None
+        )
         self.walls_between: Callable[[str, str], int] | None = None
         """How many walls stand between two hosts now, for the path loss's wall loss (None:
         none anywhere). Set by whoever knows where the hosts and walls are."""
@@ -247,8 +276,11 @@ class NetworkModel:
             delivered then, as :meth:`transmit` lists them), else what :meth:`transmit`
             returns.
         """
-        queue = self._queues.get(src) or self.queue(src)
-        t_leave = queue.enqueue(t_ns, nbytes)
+        if self._air is not None:  # the shared channel, frame overheads included
+            t_leave = self._air.enqueue(t_ns, nbytes + self._air_extra)
+        else:
+            queue = self._queues.get(src) or self.queue(src)
+            t_leave = queue.enqueue(t_ns, nbytes)
         if self._ideal_ns is not None and self._edges is None and t_leave is not None:
             # no random number could show: every copy arrives after the constant latency,
             # in order, and the links' streams need not even be drawn

@@ -359,3 +359,35 @@ def test_transmitting_to_all_at_once_stands_for_the_outcomes_transmit_lists(
             else outcome
         )
         assert expanded == each.transmit(t, src, dsts, 100, no_distance)
+
+
+def test_on_a_shared_channel_every_host_takes_its_turn_headers_and_overheads_included(streams):
+    from models.network.model import FRAME_OVERHEAD_BYTES, FRAME_OVERHEAD_NS
+
+    net = network(streams, airtime_bps=6e6)
+    first = net.transmit(0, "a", ["b"], 1000, no_distance)[0][2]
+    second = net.transmit(0, "c", ["b"], 1000, no_distance)[0][2]  # another host, same air
+    one = (1000 + FRAME_OVERHEAD_BYTES) * 8 / 6e6 * 1e9 + FRAME_OVERHEAD_NS
+    assert first == pytest.approx(one, abs=1500)  # the overhead is rounded to whole bytes
+    assert second == 2 * first
+
+
+def test_on_a_shared_channel_latency_grows_with_the_robots_sending(streams):
+    def mean_delay(hosts: int) -> float:
+        net = network(lambda name: np.random.default_rng(1), airtime_bps=6e6, queue=10_000)
+        delays = []
+        for k in range(20):  # every host sends 500 bytes at 10 Hz, all at once
+            for h in range(hosts):
+                t = k * 100 * MS
+                delays.append(net.transmit(t, f"r{h}", ["base"], 500, no_distance)[0][2] - t)
+        return float(np.mean(delays))
+
+    # a 500-byte frame holds 6 Mbit/s air 0.87 ms: k-th of n in a burst waits k of them
+    assert mean_delay(4) < mean_delay(20) < mean_delay(50)
+    assert mean_delay(4) == pytest.approx(2.5 * 0.868 * MS, rel=0.01)
+    assert mean_delay(50) == pytest.approx(25.5 * 0.868 * MS, rel=0.01)
+
+
+def test_a_shared_channel_and_per_host_bandwidth_are_not_combined(streams):
+    with pytest.raises(ModelError, match="airtime_mbps"):
+        network(streams, bandwidth_bps=1e6, airtime_bps=6e6)
