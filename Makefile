@@ -14,7 +14,7 @@ STUDY = $(BIN)/cosim study studies/$(1).toml --out $(STUDIES)/$(1) --resume
 	study-burst study-scale study-paper study-nav study-mapping study-mapping-reduced \
 	study-mapping-acceptance study-mapping-defaults study-mapping-drift map-aces map-fr079 \
 	lab-real lab-mixed study-humans study-humans-reduced study-humans-contacts study-traffic \
-	study-local-replanning study-local-replanning-network
+	study-local-replanning study-local-replanning-network study-radio
 
 help:  ## list the targets
 	@grep -E '^[a-z-]+:.*##' $(MAKEFILE_LIST) | sed 's/:.*## /\t/'
@@ -121,6 +121,9 @@ study-traffic: setup  ## traffic policies 'none', 'lanes', 'pibt' x 25/50 robots
 
 study-local-replanning: setup  ## every controller x planner on warehouse-humans, 0 and 10 workers, 8 seeds x 120 s (about 6 min)
 	$(call STUDY,local_replanning)
+
+study-radio: setup ns3  ## the built-in network model against an ns-3 radio, 4/20/50 robots x few/many shelves, 2 seeds x 60 s
+	$(call STUDY,radio)
 
 study-local-replanning-network: setup  ## dwa and orca in the lab room over network latency and loss, 4 seeds x 120 s (about 2 min)
 	$(call STUDY,local_replanning_network)

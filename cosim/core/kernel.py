@@ -74,6 +74,9 @@ class Stage(IntEnum):
     """Robot software: controllers, planners, protocols."""
     RECORD = 7
     """Samplers that write ground truth into the tables."""
+    LINK = 8
+    """A network backend catching up with the instant's messages before time moves on (an
+    external network simulator stepped event by event)."""
 
 
 class StagedTimeout(simpy.Event):

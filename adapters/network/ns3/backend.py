@@ -9,14 +9,18 @@ if its node received every fragment, at the time it did. What each host's radio 
 of each sender's last message is offered to protocols
 (:class:`~adapters.network.contract.RadioView`).
 
-The radio runs in a process of its own (:mod:`adapters.network.ns3.process`), in lockstep
-with the kernel: every ``ns3.window_ms`` the backend hands it the robots' positions and
-the messages sent in the window, lets it run to the window's end, and tells the bus what
-arrived (:meth:`cosim.core.bus.Bus.settle`). A copy that arrived within the window it was
-sent in reaches its host at the window's end, at most a window late; ``tables/radio``
-keeps the radio's own times, the received signal and SNR, and why a copy was lost
-(ns-3's reason for a frame it heard and dropped, ``unheard`` for a frame below its
-detection threshold, ``run_ended`` for what was still on the air at the end).
+The radio runs in a process of its own (:mod:`adapters.network.ns3.process`). With
+``ns3.sync = "window"`` it keeps lockstep with the kernel: every ``ns3.window_ms`` the
+backend hands it the robots' positions and the messages sent in the window, lets it run to
+the window's end, and tells the bus what arrived (:meth:`cosim.core.bus.Bus.settle`); a
+copy that arrived within the window it was sent in reaches its host at the window's end,
+at most a window late. With ``"exact"``, last in every instant with something on the air
+(stage ``LINK``) it runs the radio to the kernel's next event or to its first reception,
+whichever comes first, so every copy arrives when its radio received it and an answer
+goes on the air at its own time. ``tables/radio`` keeps the radio's own times, the
+received signal and SNR, and why a copy was lost (ns-3's reason for a frame it heard and
+dropped, ``unheard`` for a frame below its detection threshold, ``run_ended`` for what was
+still on the air at the end).
 
 Hosts that are not radio nodes (motion capture, external bridges) are wired: what they
 send arrives at once. The radio's process is seeded from the run's seed (identical
@@ -172,7 +176,13 @@ class Ns3Backend:
         )
         self.reasons = dict(self.process.call("reasons"))
         self.start_s = time.perf_counter() - started
-        run.kernel.every(self.window_ns, self._step, stage=Stage.PHYSICS, start_ns=self.window_ns)
+        self.kernel = run.kernel
+        self.exact = self.cfg.sync == "exact"
+        self.stepping = False
+        if not self.exact:
+            run.kernel.every(
+                self.window_ns, self._window, stage=Stage.PHYSICS, start_ns=self.window_ns
+            )
 
     def positions(self) -> np.ndarray:
         """Every node's position now (m, ``map``): the robots', then the base station's."""
@@ -196,22 +206,59 @@ class Ns3Backend:
         self.sends.append((t_ns + jitter, node, ticket, max(int(nbytes), 8)))
         self.flying[ticket] = (t_ns, src, tuple(dsts), topic, int(nbytes))
         self.got[ticket] = {}
+        if self.exact and not self.stepping:
+            self.stepping = True
+            self.kernel.at(t_ns, lambda: self._catch_up(t_ns), Stage.LINK)
         return Later(ticket)
 
-    def _step(self, now_ns: int) -> None:
-        """Run the radio to ``now_ns`` and settle what it can tell."""
+    def _window(self, now_ns: int) -> None:
+        """Window mode: the radio runs to the window's end."""
+        self._step(now_ns)
+
+    def _catch_up(self, now_ns: int) -> None:
+        """Exact mode: run the radio to the kernel's next event or its first reception.
+
+        Runs last in an instant (stage ``LINK``), after every message of the instant was
+        handed over; what the radio received is delivered when it received it, and this
+        runs again then, so that an answer to it goes on the air at its own time. Once
+        nothing is on the air it rests until the next message.
+        """
+        env = self.kernel.env
+        nxt = env.peek()
+        until = min(int(nxt), now_ns + GIVE_UP_NS) if nxt != float("inf") else now_ns + GIVE_UP_NS
+        radio_now = self._step(max(until, now_ns), stop_on_rx=True)
+        if self.flying or self.sends:
+            self.kernel.at(
+                max(radio_now, now_ns), lambda: self._catch_up(max(radio_now, now_ns)), Stage.LINK
+            )
+        else:
+            self.stepping = False
+
+    def _step(self, now_ns: int, *, stop_on_rx: bool = False) -> int:
+        """Run the radio to ``now_ns`` (or its first reception) and settle what it can tell.
+
+        Returns:
+            The radio's time after the run (ns).
+        """
         assert self.process is not None
         sends = None
         if self.sends:
             t, node, ticket, nbytes = (np.array(c) for c in zip(*self.sends, strict=True))
             sends = (t, node, ticket, nbytes)
             self.sends = []
-        rx_bytes, drop_bytes, took = self.process.call(
-            "step", {"positions": self.positions(), "sends": sends, "until": now_ns}
+        rx_bytes, drop_bytes, took, radio_now = self.process.call(
+            "step",
+            {
+                "positions": self.positions(),
+                "sends": sends,
+                "until": now_ns,
+                "stop_on_rx": stop_on_rx,
+            },
         )
         self.wall_s += took
         self._note(np.frombuffer(rx_bytes, RX_DTYPE), np.frombuffer(drop_bytes, DROP_DTYPE))
-        self._settle(now_ns, final=False)
+        self._settle(int(radio_now), final=False)
+        return int(radio_now)
 
     def _note(self, rx: np.ndarray, drops: np.ndarray) -> None:
         hosts = list(self.node)

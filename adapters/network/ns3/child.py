@@ -7,8 +7,9 @@ the run keeps the tail of. Requests:
 - ``("setup", kwargs)``: build the radio (:class:`~adapters.network.ns3.radio.Radio`);
   answers the seconds it took;
 - ``("step", {"positions": (n, 2) or None, "sends": (t_ns, src, ids, nbytes) or None,
-  "until": t_ns})``: move the nodes, schedule the sends, run to ``until``; answers
-  ``(rx bytes, drop bytes, seconds)``;
+  "until": t_ns, "stop_on_rx": bool})``: move the nodes, schedule the sends, run to
+  ``until`` (or to the first reception); answers ``(rx bytes, drop bytes, seconds, the
+  radio's time in ns)``;
 - ``("abort", None)``: make ns-3 abort this process (to test that a run contains it);
 - ``("exit", None)``: answer and exit.
 
@@ -58,8 +59,10 @@ def serve() -> None:
                     current.set_positions(argument["positions"])
                 if argument["sends"] is not None:
                     current.send_many(*argument["sends"])
-                rx, drops = current.run_until(argument["until"])
-                result = (rx.tobytes(), drops.tobytes(), time.perf_counter() - t)
+                rx, drops = current.run_until(
+                    argument["until"], stop_on_rx=argument.get("stop_on_rx", False)
+                )
+                result = (rx.tobytes(), drops.tobytes(), time.perf_counter() - t, current.now_ns)
             elif command == "reasons":
                 result = radio.REASONS
             elif command == "abort":

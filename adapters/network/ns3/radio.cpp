@@ -405,9 +405,13 @@ class RadioSim
         if (tNs < now)
             throw std::invalid_argument("run_until " + std::to_string(tNs) + " ns is before now " +
                                         std::to_string(now) + " ns");
-        Simulator::Stop(NanoSeconds(tNs - now));
+        // a reception may stop the run first (SetStopOnRx): the stop at tNs must not outlive it
+        EventId stop = Simulator::Stop(NanoSeconds(tNs - now));
         Simulator::Run();
+        Simulator::Cancel(stop);
     }
+    /// Stop every run at the first reception (the exact mode's step), or not.
+    void SetStopOnRx(bool on) { m_stopOnRx = on; }
     int64_t NowNs() const { return Simulator::Now().GetNanoSeconds(); }
 
     // ---- draining records -------------------------------------------------
@@ -510,6 +514,8 @@ class RadioSim
             r.snr_db = fresh ? m_lastSnr[rx] : std::nan("");
             m_rx.push_back(r);
         }
+        if (m_stopOnRx)
+            Simulator::Stop();
     }
 
     static void SniffRx(RadioSim* self, uint32_t node, Ptr<const Packet>, uint16_t,
@@ -573,6 +579,7 @@ class RadioSim
     }
 
     bool m_setup{false};
+    bool m_stopOnRx{false};
     RadioConfig m_cfg;
     NodeContainer m_nodes;
     uint32_t m_nodeBase{0};

@@ -118,14 +118,26 @@ class Radio:
                 len(t),
             )
 
-    def run_until(self, t_ns: int) -> tuple[np.ndarray, np.ndarray]:
-        """Run to ``t_ns`` (ns); the receptions and drops recorded since the last run."""
+    def run_until(self, t_ns: int, *, stop_on_rx: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """Run to ``t_ns`` (ns), or to the first reception; the records since the last run.
+
+        Args:
+            t_ns: where to stop (ns).
+            stop_on_rx: stop right after the first message is received (:attr:`now_ns`
+                says when), so that whoever gets it may answer before the radio moves on.
+        """
+        self.sim.SetStopOnRx(bool(stop_on_rx))
         _call(self.sim.RunUntil, int(t_ns))
         rx = np.empty(int(self.sim.NumRx()), dtype=RX_DTYPE)
         self.sim.DrainRx(rx.ctypes.data)
         drops = np.empty(int(self.sim.NumDrop()), dtype=DROP_DTYPE)
         self.sim.DrainDrop(drops.ctypes.data)
         return rx, drops
+
+    @property
+    def now_ns(self) -> int:
+        """The radio's time (ns)."""
+        return int(self.sim.NowNs())
 
     def abort_for_test(self) -> None:
         """Make ns-3 abort the process at the next run (an event in the past)."""

@@ -24,6 +24,7 @@ from typing import ClassVar, Literal
 from cosim.scenario.fields import param
 
 Standard = Literal["80211a", "80211g", "80211n", "80211p"]
+Sync = Literal["window", "exact"]
 Fading = Literal["none", "nakagami"]
 
 
@@ -68,6 +69,13 @@ class Ns3Settings:
         "loss for every wall, shelf or obstacle the straight line between two nodes meets (dB)",
         ge=0,
         le=100,
+    )
+    sync: Sync = param(
+        "window",
+        "how the radio keeps time with the kernel: 'window' (lockstep windows of window_ms: "
+        "a message received within its window arrives at the window's end) or 'exact' (the "
+        "radio runs to the next kernel event or the next reception, whichever comes first: "
+        "every message arrives when its radio received it, one exchange per instant)",
     )
     window_ms: float = param(
         10.0,

@@ -146,3 +146,39 @@ def test_ns3_aborting_mid_run_ends_the_run_in_one_line_keeping_what_ran(tmp_path
     kept = died.value.kept
     assert kept is not None and 0.9 < kept.summary["sim_time_s"] < 1.1
     assert len(kept.tables["radio"]) > 0
+
+
+def _delivered(sync: str) -> tuple[list[tuple[int, int]], pd.DataFrame]:
+    """robot_1 publishes at 1 ms and 33 ms; (sent, received) at robot_2, and the radio table."""
+    from cosim.core.hosts import HostId
+    from cosim.core.messages import Twist
+    from cosim.runner.assembly import assemble
+
+    scenario = cosim.load_scenario(
+        "warehouse-random", {**ROOM, "ns3.sync": sync, "ns3.send_jitter_ms": 0.0}
+    )
+    assembly = assemble(scenario, names=["network"])
+    run = assembly.run
+    got: list[tuple[int, int]] = []
+    run.bus.advertise("/probe", Twist)
+    run.bus.subscribe(
+        "/probe", HostId("robot_2"), lambda m, e: got.append((e.t_sent_ns, e.t_recv_ns))
+    )
+    for _name, adapter in assembly.adapters:
+        adapter.start(run)
+    for t in (1_000_000, 33_000_000):
+        run.kernel.at(t, lambda: run.bus.publish("/probe", Twist(1.0, 0.0), HostId("robot_1")))
+    run.kernel.run(100_000_000)
+    for _name, adapter in assembly.adapters:
+        adapter.finish(run)
+    return got, pd.DataFrame(run.recorder.tables["radio"].columns())
+
+
+@pytest.mark.slow
+def test_in_exact_mode_a_message_arrives_when_its_radio_received_it_and_in_windows_after():
+    exact, radio = _delivered("exact")
+    heard = radio[(radio.dst == "robot_2") & (radio.topic == "/probe")]
+    assert [r for _, r in exact] == [round(t * 1e9) for t in heard.t_radio_s]
+    assert all(0 < r - s < 2_000_000 for s, r in exact)  # 35 m, a 6 Mbit/s frame: < 2 ms
+    windows, _ = _delivered("window")
+    assert [r for _, r in windows] == [10_000_000, 40_000_000]  # the windows' ends

@@ -45,7 +45,7 @@ def test_a_refused_request_is_said_and_the_radio_serves_on(radio):
         "sends": (np.array([1_000_000]), np.array([0]), np.array([42]), np.array([200])),
         "until": 10_000_000,
     }
-    rx_bytes, _drops, _took = radio.call("step", step)
+    rx_bytes, _drops, _took, _now = radio.call("step", step)
     rx = np.frombuffer(rx_bytes, RX_DTYPE)
     assert rx["msg_id"].tolist() == [42] and rx["rx"].tolist() == [1]
     assert 1_000_000 < rx["t_ns"][0] < 2_000_000 and -70 < rx["rssi_dbm"][0] < -50
