@@ -23,9 +23,10 @@ dropped, ``unheard`` for a frame below its detection threshold, ``run_ended`` fo
 still on the air at the end).
 
 Hosts that are not radio nodes (motion capture, external bridges) are wired: what they
-send arrives at once. The radio's process is seeded from the run's seed (identical
-tables on re-run) and dies with the run; if ns-3 aborts it, the run ends with one line
-naming ns-3's reason and keeps what it recorded.
+send arrives at once. The radio is seeded from the run's seed (identical tables on
+re-run); its process is kept for the next run of the same process (a study's worker starts
+one), and dies with it; if ns-3 aborts it, the run ends with one line naming ns-3's reason
+and keeps what it recorded.
 """
 
 from __future__ import annotations
@@ -38,7 +39,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from adapters.network.contract import NetworkContext, RadioView
-from adapters.network.ns3.process import RadioProcess
+from adapters.network.ns3.process import RadioProcess, acquire, release
 from adapters.network.ns3.settings import Ns3Settings
 from adapters.network.ns3.wire import DROP_DTYPE, RX_DTYPE
 from adapters.network.settings import NetworkConfig
@@ -156,7 +157,7 @@ class Ns3Backend:
         """Start the radio's process, build the network, and step it every window."""
         started = time.perf_counter()
         self.bus = run.bus
-        self.process = RadioProcess()
+        self.process = acquire()
         self.process.call(
             "setup",
             {
@@ -350,7 +351,7 @@ class Ns3Backend:
         }
 
     def close(self) -> None:
-        """Stop the radio's process (again: nothing)."""
+        """Hand the radio's process back for the next run of this process (again: nothing)."""
         if self.process is not None:
-            self.process.close()
+            release(self.process)
             self.process = None

@@ -4,13 +4,19 @@ ns-3 reports what it finds wrong inside by aborting its process (its asserts are
 the wheel), so the radio runs in a child process the run owns
 (:mod:`adapters.network.ns3.child`): the child dies, the run does not. The run talks to it
 over pipes, one request and one answer at a time; the child's standard error is read by a
-thread into a bounded tail, whose ns-3 lines explain a death. The child exits when the
-run closes it, and dies with the run (its pipes close; on Linux it also gets SIGKILL when
-its parent dies).
+thread into a bounded tail, whose ns-3 lines explain a death. The child dies with the
+process that started it (its pipes close; on Linux it also gets SIGKILL when its parent
+dies).
+
+Starting one takes 10-15 s (ns-3's import and its templates' compilation), so a process
+keeps the radios its runs are done with (:func:`acquire`, :func:`release`): a study's
+worker starts one radio and builds each run's network in it anew (building resets ns-3's
+state, so a reused radio gives the records a fresh one would: checked byte for byte).
 """
 
 from __future__ import annotations
 
+import atexit
 import collections
 import contextlib
 import os
@@ -44,6 +50,38 @@ def _die_with_parent() -> None:  # pragma: no cover  (runs in the child before e
         ctypes.CDLL("libc.so.6").prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
     except OSError:
         pass
+
+
+_IDLE: list[RadioProcess] = []
+"""Radios of this process that no run uses now, alive and answering."""
+
+
+def acquire() -> RadioProcess:
+    """A radio for a run: one this process kept, else a new one."""
+    while _IDLE:
+        process = _IDLE.pop()
+        if process.alive():
+            return process
+    return RadioProcess()
+
+
+def release(process: RadioProcess) -> None:
+    """A run is done with ``process``: keep it for the next run if it still answers."""
+    if not process.alive():
+        process.close()
+        return
+    try:
+        process.call("reasons")  # answers in turn: no request of the run left half-done
+    except BridgeError:
+        process.close()
+        return
+    _IDLE.append(process)
+
+
+@atexit.register
+def _close_idle() -> None:
+    while _IDLE:
+        _IDLE.pop().close()
 
 
 class RadioProcess:
