@@ -47,6 +47,7 @@ TOGGLES = {
     "hungarian": {"assignment.protocol": "hungarian"},
     "mapping sharing scans": {"mapping.enabled": True, "mapping.share": "scans"},
     "physical robot on its odometry": {"physical.robots": ["robot_1"], "physical.pose": "odom"},
+    "ns-3 radio": {"network.backend": "ns3"},
 }
 """Features that add summary keys, each on the small warehouse-random."""
 LIVE_ONLY = {

@@ -1,5 +1,5 @@
 import numpy as np
-from hypothesis import given
+from hypothesis import example, given
 from hypothesis import strategies as st
 from shapely.geometry import LineString, box
 
@@ -30,6 +30,7 @@ def test_axis_parallel_lines_inside_and_outside_a_slab():
 coord = st.floats(-1.0, 9.0, allow_nan=False)
 
 
+@example([(0.0, 1.0, 2.0, -9.208399652212099e-294)])  # grazes a corner by 1e-293 m
 @given(st.lists(st.tuples(coord, coord, coord, coord), min_size=1, max_size=20))
 def test_it_agrees_with_shapely_on_any_segment(segments):
     seg = np.array(segments)
@@ -38,7 +39,10 @@ def test_it_agrees_with_shapely_on_any_segment(segments):
     for (x0, y0, x1, y1), n in zip(segments, got, strict=True):
         line = LineString([(x0, y0), (x1, y1)]) if (x0, y0) != (x1, y1) else None
         if line is None:
-            want = sum(b.intersects(LineString([(x0, y0), (x0, y0 + 1e-12)])) for b in boxes)
-        else:
-            want = sum(b.intersects(line) for b in boxes)
-        assert n == want, ((x0, y0, x1, y1), n, want)
+            line = LineString([(x0, y0), (x0, y0 + 1e-12)])
+        want = sum(b.intersects(line) for b in boxes)
+        # a segment passing within a nanometre of a box's edge may round either way
+        grazing = sum(
+            (b.distance(line) < 1e-9 and not b.intersects(line)) or b.touches(line) for b in boxes
+        )
+        assert abs(n - want) <= grazing, ((x0, y0, x1, y1), n, want)
