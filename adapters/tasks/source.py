@@ -4,15 +4,14 @@ It opens ``tasks.initial`` tasks at pick stations (shelf faces) at the start and
 whenever one is completed (as in the paper), up to ``tasks.max_total``. Open tasks stand
 at stations at least two footprints plus ``tasks.station_offset_m`` apart, so that their
 robots never serve in each other's way; a task with no such station left waits for the
-next completion. The open tasks
-are broadcast as a :class:`~cosim.core.messages.TaskSet` over the network whenever they change
-(a new *epoch*) and every ``assignment.rebroadcast_s``. It keeps the book of claims and is
-the one authority on service: a robot at a task asks for the right to serve it, and only
-one robot ever gets it (see :mod:`models.tasks.book`). How claims are kept is the
-assignment's to say (:mod:`adapters.tasks.contract`); with a central solver (a protocol
-whose ``central`` is true, such as ``hungarian``) it also asks the solver, at every
-announcement, for the free robots' tasks from their reported poses and sends each robot its
-order over the network.
+next completion. The open tasks are broadcast as a :class:`~cosim.core.messages.TaskSet`
+over the network whenever they change (a new *epoch*) and every
+``assignment.rebroadcast_s``. It keeps the book of claims and is the one authority on
+service: a robot at a task asks for the right to serve it, and only one robot ever gets it
+(see :mod:`models.tasks.book`). How claims are kept is the assignment's to say
+(:mod:`adapters.tasks.contract`); with a central solver (a protocol whose ``central`` is
+true, such as ``hungarian``) it also asks the solver, at every announcement, for the free
+robots' tasks from their reported poses and sends each robot its order over the network.
 """
 
 from __future__ import annotations

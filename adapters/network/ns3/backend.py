@@ -224,14 +224,13 @@ class Ns3Backend:
         runs again then, so that an answer to it goes on the air at its own time. Once
         nothing is on the air it rests until the next message.
         """
-        env = self.kernel.env
-        nxt = env.peek()
-        until = min(int(nxt), now_ns + GIVE_UP_NS) if nxt != float("inf") else now_ns + GIVE_UP_NS
-        radio_now = self._step(max(until, now_ns), stop_on_rx=True)
+        nxt = self.kernel.env.peek()  # the kernel's next event, this one already taken
+        until = now_ns + GIVE_UP_NS
+        if nxt != float("inf"):
+            until = max(min(int(nxt), until), now_ns)
+        then = max(self._step(until, stop_on_rx=True), now_ns)
         if self.flying or self.sends:
-            self.kernel.at(
-                max(radio_now, now_ns), lambda: self._catch_up(max(radio_now, now_ns)), Stage.LINK
-            )
+            self.kernel.at(then, lambda: self._catch_up(then), Stage.LINK)
         else:
             self.stepping = False
 
