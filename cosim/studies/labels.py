@@ -83,6 +83,7 @@ LABELS: Mapping[str, str] = MappingProxyType(
         "network.loss_model": "Loss model",
         "network.profile": "Network profile",
         "network.bandwidth_mbps": "Network bandwidth (Mbit/s)",
+        "network.backend": "Network (backend)",
         "assignment.protocol": "Assignment protocol",
         "humans.workers": "Workers on the floor",
         "mapping.share": "Map sharing",
@@ -91,6 +92,7 @@ LABELS: Mapping[str, str] = MappingProxyType(
         "navigation.traffic": "Traffic planner",
         "navigation.robots_layer": "Robots layer (others' footprints)",
         "world.layout": "Shelf layout",
+        "world.shelf_count": "Shelves",
     }
 )
 """Labels of the columns the shipped studies (``studies/*.toml``) plot, by column name."""

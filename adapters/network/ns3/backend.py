@@ -25,7 +25,7 @@ still on the air at the end).
 Hosts that are not radio nodes (motion capture, external bridges) are wired: what they
 send arrives at once. The radio is seeded from the run's seed (identical tables on
 re-run); its process is kept for the next run of the same process (a study's worker starts
-one), and dies with it; if ns-3 aborts it, the run ends with one line naming ns-3's reason
+one), and exits with it; if ns-3 aborts it, the run ends with one line naming ns-3's reason
 and keeps what it recorded.
 """
 

@@ -4,9 +4,10 @@ ns-3 reports what it finds wrong inside by aborting its process (its asserts are
 the wheel), so the radio runs in a child process the run owns
 (:mod:`adapters.network.ns3.child`): the child dies, the run does not. The run talks to it
 over pipes, one request and one answer at a time; the child's standard error is read by a
-thread into a bounded tail, whose ns-3 lines explain a death. The child dies with the
-process that started it (its pipes close; on Linux it also gets SIGKILL when its parent
-dies).
+thread into a bounded tail, whose ns-3 lines explain a death. The child ends with the
+process that started it: its requests' pipe closes, and it exits (not Linux's
+parent-death signal, which follows the starting *thread*: a study worker's thread pool
+would kill radios its next runs could use).
 
 Starting one takes 10-15 s (ns-3's import and its templates' compilation), so a process
 keeps the radios its runs are done with (:func:`acquire`, :func:`release`): a study's
@@ -40,16 +41,6 @@ class RadioDiedError(BridgeError):
 
 class RadioRefusedError(BridgeError):
     """The radio refused a request (the process lives on)."""
-
-
-def _die_with_parent() -> None:  # pragma: no cover  (runs in the child before exec)
-    """Ask Linux to kill the child when the run's process dies."""
-    try:
-        import ctypes
-
-        ctypes.CDLL("libc.so.6").prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
-    except OSError:
-        pass
 
 
 _IDLE: list[RadioProcess] = []
@@ -100,7 +91,6 @@ class RadioProcess:
             stderr=subprocess.PIPE,
             bufsize=0,
             close_fds=True,
-            preexec_fn=_die_with_parent if sys.platform.startswith("linux") else None,
             env={**os.environ, "PYTHONUNBUFFERED": "1"},
         )
         assert self.proc.stdin is not None and self.proc.stdout is not None

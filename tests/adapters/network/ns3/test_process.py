@@ -5,7 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from adapters.network.ns3.process import RadioDiedError, RadioProcess, RadioRefusedError
+from adapters.network.ns3.process import (
+    RadioDiedError,
+    RadioProcess,
+    RadioRefusedError,
+    acquire,
+    release,
+)
 from adapters.network.ns3.wire import RX_DTYPE
 
 pytestmark = pytest.mark.slow
@@ -28,10 +34,10 @@ SETUP = {
 
 @pytest.fixture(scope="module")
 def radio():
-    process = RadioProcess()
+    process = acquire()  # this worker's radio, if a run left one: no new start
     process.call("setup", SETUP)
     yield process
-    process.close()
+    release(process)
 
 
 def test_a_refused_request_is_said_and_the_radio_serves_on(radio):
