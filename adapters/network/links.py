@@ -195,6 +195,9 @@ class LinksBackend(ModelLink):
         super().__init__(model, self._distance_m)
         if cfg.path_loss and cfg.wall_loss_db > 0:
             self.boxes = np.asarray(run.service(Warehouse).inner_boxes, dtype=float).reshape(-1, 4)
+            self.kernel = run.kernel
+            self._walls = np.zeros((len(self.robots), len(self.robots)), dtype=np.int64)
+            self._walls_ns = -1
             model.walls_between = self._walls_between
         choice: TopologyChoice = TOPOLOGIES.installed().get(cfg.topology)(context)
         self.topology = _checked(self.source, choice.edges)
@@ -214,13 +217,24 @@ class LinksBackend(ModelLink):
         return float(np.hypot(fleet.x[i] - fleet.x[j], fleet.y[i] - fleet.y[j]))
 
     def _walls_between(self, a: str, b: str) -> int:
-        """Walls, shelves and obstacles the straight line between two robots meets."""
+        """Walls, shelves and obstacles the straight line between two robots meets.
+
+        Counted for every pair at once, in one call, the first time it is asked in an
+        instant (robots move between instants, not within one).
+        """
         i, j = self._index.get(a), self._index.get(b)
         if i is None or j is None:
             return 0
-        fleet = self.fleet
-        ends = np.array([[fleet.x[i], fleet.y[i]]]), np.array([[fleet.x[j], fleet.y[j]]])
-        return int(boxes_crossed(*ends, self.boxes)[0])
+        now = self.kernel.now_ns
+        if now != self._walls_ns:
+            fleet = self.fleet
+            xy = np.column_stack([fleet.x, fleet.y])
+            p, q = np.triu_indices(len(xy), 1)
+            crossed = boxes_crossed(xy[p], xy[q], self.boxes)
+            self._walls[p, q] = crossed
+            self._walls[q, p] = crossed
+            self._walls_ns = now
+        return int(self._walls[i, j])
 
     def _check_partition_hosts(self, run: RunContext) -> None:
         known = set(run.hosts)

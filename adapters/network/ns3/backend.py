@@ -39,11 +39,12 @@ from typing import Any, ClassVar
 import numpy as np
 
 from adapters.network.contract import NetworkContext, RadioView
-from adapters.network.ns3.process import RadioProcess, acquire, release
+from adapters.network.ns3.process import RadioProcess, RadioRefusedError, acquire, release
 from adapters.network.ns3.settings import Ns3Settings
 from adapters.network.ns3.wire import DROP_DTYPE, RX_DTYPE
 from adapters.network.settings import NetworkConfig
 from cosim.core.adapter import RunContext
+from cosim.core.errors import ConfigError
 from cosim.core.hosts import BASE_HOST, HostId
 from cosim.core.kernel import Stage
 from cosim.core.link import DELIVERED, AllDelivered, Later, Transfer
@@ -52,6 +53,7 @@ from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S
 from cosim.scenario.fields import Problem
 from models.fleet.kinematics import FleetState
+from models.network.radio import PathLoss
 from models.network.shadowing import boxes_crossed
 from models.network.topology import Edges, edge
 from models.world.warehouse import Warehouse
@@ -130,6 +132,15 @@ class Ns3Backend:
         )
         self.boxes = np.asarray(world.inner_boxes, dtype=float).reshape(-1, 4)
         self.seed = run.scenario.seed
+        self.source = run.scenario.source
+        self.mean_power = PathLoss(
+            tx_power_dbm=self.cfg.tx_power_dbm,
+            ref_loss_db=self.cfg.reference_loss_db,
+            exponent=self.cfg.path_loss_exponent,
+            sensitivity_dbm=self.cfg.detection_threshold_dbm,
+            shadowing_db=0.0,
+        )
+        """The radio's mean received power without fading (who hears whom, :meth:`links_at`)."""
         self.window_ns = max(round(self.cfg.window_ms * 1e6), 1)
         self.jitter_ns = round(self.cfg.send_jitter_ms * 1e6)
         self.rng = run.rng.stream("ns3/jitter")
@@ -158,23 +169,14 @@ class Ns3Backend:
         started = time.perf_counter()
         self.bus = run.bus
         self.process = acquire()
-        self.process.call(
-            "setup",
-            {
-                "n_nodes": len(self.node),
-                "standard": self.cfg.standard,
-                "rate": self.cfg.rate,
-                "tx_power_dbm": self.cfg.tx_power_dbm,
-                "exponent": self.cfg.path_loss_exponent,
-                "reference_loss_db": self.cfg.reference_loss_db,
-                "nakagami": self.cfg.fading == "nakagami",
-                "detection_dbm": self.cfg.detection_threshold_dbm,
-                "walls": self.boxes.ravel().tolist(),
-                "wall_loss_db": self.cfg.wall_loss_db,
-                "seed": 1 + self.seed % (2**31 - 2),
-                "run": 1,
-            },
-        )
+        try:
+            self.process.call("setup", self._radio_config())
+        except RadioRefusedError as refused:  # the only key the radio alone can check
+            known = str(refused).rsplit("known:", 1)[-1].split()
+            raise ConfigError(
+                f"{self.source}: [ns3] rate = {self.cfg.rate!r}: not a mode of "
+                f"{self.cfg.standard}; expected one of {', '.join(known)}"
+            ) from None
         self.reasons = dict(self.process.call("reasons"))
         self.start_s = time.perf_counter() - started
         self.kernel = run.kernel
@@ -184,6 +186,23 @@ class Ns3Backend:
             run.kernel.every(
                 self.window_ns, self._window, stage=Stage.PHYSICS, start_ns=self.window_ns
             )
+
+    def _radio_config(self) -> dict[str, Any]:
+        """What the radio's ``setup`` is built from (the ``[ns3]`` keys, the walls, the seed)."""
+        return {
+            "n_nodes": len(self.node),
+            "standard": self.cfg.standard,
+            "rate": self.cfg.rate,
+            "tx_power_dbm": self.cfg.tx_power_dbm,
+            "exponent": self.cfg.path_loss_exponent,
+            "reference_loss_db": self.cfg.reference_loss_db,
+            "nakagami": self.cfg.fading == "nakagami",
+            "detection_dbm": self.cfg.detection_threshold_dbm,
+            "walls": self.boxes.ravel().tolist(),
+            "wall_loss_db": self.cfg.wall_loss_db,
+            "seed": 1 + self.seed % (2**31 - 2),
+            "run": 1,
+        }
 
     def positions(self) -> np.ndarray:
         """Every node's position now (m, ``map``): the robots', then the base station's."""
@@ -321,16 +340,10 @@ class Ns3Backend:
         xy = self.positions()
         hosts = list(self.node)
         i, j = np.triu_indices(len(hosts), 1)
-        d = np.maximum(np.hypot(*(xy[i] - xy[j]).T), 1.0)
+        d = np.hypot(*(xy[i] - xy[j]).T)  # the path loss takes under 1 m as 1 m
         walls = boxes_crossed(xy[i], xy[j], self.boxes)
-        cfg = self.cfg
-        power = (
-            cfg.tx_power_dbm
-            - cfg.reference_loss_db
-            - 10 * cfg.path_loss_exponent * np.log10(d)
-            - cfg.wall_loss_db * walls
-        )
-        up = power >= cfg.detection_threshold_dbm
+        power = self.mean_power.rssi_dbm(d) - self.cfg.wall_loss_db * walls
+        up = power >= self.cfg.detection_threshold_dbm
         return frozenset(edge(hosts[a], hosts[b]) for a, b in zip(i[up], j[up], strict=True))
 
     def robot_graph(self) -> tuple[list[str], Edges]:

@@ -292,3 +292,15 @@ def test_a_wall_loss_without_the_path_loss_is_refused():
 
     with pytest.raises(ConfigError, match="wall_loss_db"):
         cosim.load_scenario("warehouse-random", {"network.wall_loss_db": 10.0})
+
+
+def test_a_shared_channel_with_a_per_host_bandwidth_is_refused():
+    import pytest
+
+    import cosim
+    from cosim.core.errors import ConfigError
+
+    with pytest.raises(ConfigError, match=r"bandwidth_mbps.*airtime_mbps"):
+        cosim.load_scenario(
+            "warehouse-random", {"network.airtime_mbps": 6.0, "network.bandwidth_mbps": 50.0}
+        )

@@ -185,3 +185,13 @@ def test_in_exact_mode_a_message_arrives_when_its_radio_received_it_and_in_windo
     assert all(0 < r - s < 2_000_000 for s, r in exact)  # 35 m, a 6 Mbit/s frame: < 2 ms
     windows, _ = _delivered("window")
     assert [r for _, r in windows] == [10_000_000, 40_000_000]  # the windows' ends
+
+
+@pytest.mark.slow
+def test_a_rate_the_standard_does_not_have_is_refused_naming_the_key_and_the_known_ones(tmp_path):
+    scenario = cosim.load_scenario(
+        "warehouse-random", {**ROOM, "ns3.rate": "Bogus", "scenario.duration_s": 1.0}
+    )
+    with pytest.raises(ConfigError, match=r"\[ns3\] rate = 'Bogus': not a mode of 80211g") as bad:
+        cosim.run(scenario, out=tmp_path / "bogus")
+    assert "ErpOfdmRate6Mbps" in str(bad.value)
