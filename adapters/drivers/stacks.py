@@ -27,3 +27,9 @@ TELEOP = Driver(
     "the last one, avoiding nothing",
     needs_lidar=False,
 )
+AGENTS = Driver(
+    ("agents",),
+    "learning agents: a Gymnasium or PettingZoo environment (cosim.envs) decides every "
+    "robot's velocity or goal ([agents])",
+    needs_lidar=False,
+)

@@ -5,7 +5,7 @@ shelves, other robots and dynamic obstacles; a robot whose proposed pose overlap
 anything is held at its last pose with zero velocity ("stopped": it never passes
 through nor jumps). Robots held back may in turn block others, so holding repeats until
 no robot moves into contact. Each new contact is a row in ``tables/collisions`` (t_s,
-robot, other, kind = wall | shelf | robot | person | forklift | dynamic, depth_m,
+robot, other, kind = wall | shelf | obstacle | robot | person | forklift | dynamic, depth_m,
 speed_mps: the robot's speed in the step that touched, 0 when something moved into a
 robot at rest) and an event; the smallest clearance over the run and the near misses
 (clearance below ``NEAR_MISS_M``) go into the summary.
@@ -14,9 +14,11 @@ robot at rest) and an event; the smallest clearance over the run and the near mi
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
+import numpy.typing as npt
 
 from adapters.fleet.motion import FleetAdapter
 from cosim.core.adapter import RunContext
@@ -36,8 +38,9 @@ COLLISIONS = TableSpec(
     {
         "t_s": "when the contact began (s)",
         "robot": "the robot",
-        "other": "what it touched: wall_i, shelf_i, another robot's name, a person's id",
-        "kind": "wall, shelf, robot, or the kind of a moving thing (person, forklift)",
+        "other": "what it touched: wall_i, shelf_i, obstacle_i (world.obstacles), another "
+        "robot's name, a person's id",
+        "kind": "wall, shelf, obstacle, robot, or the kind of a moving thing (person, forklift)",
         "depth_m": "how far the step would have gone into it (m)",
         "speed_mps": "the robot's commanded speed at the contact (m/s): 0 means it stood still",
     },
@@ -47,6 +50,18 @@ COLLISION_COLUMNS = tuple(COLLISIONS.columns)
 
 Pair = tuple[int, int, int]
 """(robot, kind, other) of a pair in contact or near each other."""
+
+
+@dataclass(frozen=True)
+class ContactCounts:
+    """A service of the run: every robot's contacts so far, as they happen.
+
+    Attributes:
+        by_robot: new contacts of each robot (fleet order), the rows of
+            ``tables/collisions`` counted by robot.
+    """
+
+    by_robot: npt.NDArray[np.int64]
 
 
 class CollisionsAdapter:
@@ -76,8 +91,12 @@ class CollisionsAdapter:
         self.checker = CollisionChecker(world.boxes, self.fleet.radius_m, margin_m=NEAR_MISS_M)
         walls = [f"wall_{i}" for i in range(len(world.walls))]
         shelves = [f"shelf_{i}" for i in range(len(world.shelves))]
-        self.static_names = walls + shelves
-        self.static_kinds = ["wall"] * len(walls) + ["shelf"] * len(shelves)
+        obstacles = [f"obstacle_{i}" for i in range(len(world.obstacles))]
+        # in the order of world.boxes, which the checker's static indices count
+        self.static_names = walls + shelves + obstacles
+        self.static_kinds = (
+            ["wall"] * len(walls) + ["shelf"] * len(shelves) + ["obstacle"] * len(obstacles)
+        )
         self.table = run.recorder.table(COLLISIONS)
         self.recorder = run.recorder
         self.contacts: set[Pair] = set()
@@ -85,6 +104,8 @@ class CollisionsAdapter:
         self.collisions = 0
         self.near_misses = 0
         self.min_clearance_m = np.inf
+        self.counts = ContactCounts(np.zeros(len(self.fleet), dtype=np.int64))
+        run.provide(self.counts)
         run.service(FleetAdapter).add_guard(self.guard)
 
     def start(self, run: RunContext) -> None:
@@ -169,6 +190,7 @@ class CollisionsAdapter:
             )
             self.recorder.event(now_ns, robot, "collision", f"{kind} {other}, robot stopped")
             self.collisions += 1
+            self.counts.by_robot[p.robot] += 1
 
     def finish(self, run: RunContext) -> Mapping[str, Any]:
         """Collisions, near misses and the smallest clearance (m; None if never checked)."""

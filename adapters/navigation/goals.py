@@ -36,6 +36,35 @@ RETRY_S = 1.0
 """After a goal found unreachable, the next goal goes out this much later (s)."""
 
 
+def goal_cells(static: StaticCostmap, radius_m: float, fleet: FleetState) -> list[np.ndarray]:
+    """The cells each robot may be sent to: free ones of its own connected region.
+
+    A goal cell keeps :data:`GOAL_CLEARANCE_M` beyond the footprint from every obstacle
+    and lies in the free region the robot stands in (robots in one region share one array).
+
+    Args:
+        static: the inflated static map.
+        radius_m: the robots' footprint radius (m).
+        fleet: the robots, where they start.
+
+    Returns:
+        Per robot, the (k, 2) cells ``(iy, ix)`` it may be sent to (k = 0: none).
+    """
+    free = static.distance_m >= radius_m + GOAL_CLEARANCE_M
+    labels, _ = ndimage.label(static.cost < 253, structure=np.ones((3, 3)))
+    # the goal cells of each region, found once and shared by the robots in it (a
+    # list per robot grows with robots x floor: 16 GB for 1,000 robots in 100 m x 100 m)
+    by_region: dict[int, np.ndarray] = {0: np.zeros((0, 2), dtype=np.int64)}
+    cells: list[np.ndarray] = []
+    for x, y in zip(fleet.x, fleet.y, strict=True):
+        ix, iy = static.world_to_cell((x, y))
+        label = int(labels[iy, ix])
+        if label not in by_region:
+            by_region[label] = np.argwhere(free & (labels == label))  # (k, 2) as (iy, ix)
+        cells.append(by_region[label])
+    return cells
+
+
 class GoalsAdapter:
     """Sends each robot random reachable goals, one after another."""
 
@@ -51,20 +80,8 @@ class GoalsAdapter:
         self.names = list(fleet.names)
         self.hosts = [HostId(n) for n in self.names]
         static = run.service(StaticCostmap)
-        radius = run.settings(RobotsConfig).radius_m
-        free = static.distance_m >= radius + GOAL_CLEARANCE_M
-        labels, _ = ndimage.label(static.cost < 253, structure=np.ones((3, 3)))
         self.static = static
-        # the goal cells of each region, found once and shared by the robots in it (a
-        # list per robot grows with robots x floor: 16 GB for 1,000 robots in 100 m x 100 m)
-        by_region: dict[int, np.ndarray] = {0: np.zeros((0, 2), dtype=np.int64)}
-        self.cells: list[np.ndarray] = []
-        for x, y in zip(fleet.x, fleet.y, strict=True):
-            ix, iy = static.world_to_cell((x, y))
-            label = int(labels[iy, ix])
-            if label not in by_region:
-                by_region[label] = np.argwhere(free & (labels == label))  # (k, 2) as (iy, ix)
-            self.cells.append(by_region[label])
+        self.cells = goal_cells(static, run.settings(RobotsConfig).radius_m, fleet)
         width, height = run.settings(WorldConfig).size_m
         for x, y in run.settings(NavigationConfig).goals:
             if not (0 <= x <= width and 0 <= y <= height):

@@ -321,6 +321,46 @@ class Kernel:
             progress(self.now_ns, processed)
         return processed
 
+    def advance(self, until_ns: int, woken: Callable[[], bool]) -> int:
+        """Process events due before ``until_ns``, ending early after an instant that woke.
+
+        After the last event of each instant, ``woken()`` is asked; if true, the kernel stops
+        there (``now_ns`` is that instant, all of its events processed), else it goes on.
+        Otherwise as :meth:`run` without progress: ``now_ns`` ends at ``until_ns``. A
+        learning environment's event-driven decisions (:mod:`cosim.envs`) are made so.
+
+        Args:
+            until_ns: the latest end (ns).
+            woken: whether something happened that the caller stops for.
+
+        Returns:
+            The number of events processed.
+        """
+        if self.realtime:
+            raise ValueError("advance() steps a kernel that is not paced in real time")
+        env = self.env
+        self._flush_after()
+        step, peek = env.step, env.peek
+        processed = 0
+        try:
+            while peek() < until_ns:
+                step()
+                if self._after:
+                    self._flush_after()
+                processed += 1
+                if peek() > env.now and woken():
+                    return processed
+        except BaseException as error:
+            original = escaped(error)
+            if original is error:
+                raise
+            raise original from original.__cause__
+        finally:
+            self.events_processed += processed
+        if until_ns > self.now_ns:
+            env.run(until=until_ns)
+        return processed
+
     def _run_realtime(
         self,
         env: simpy.rt.RealtimeEnvironment,

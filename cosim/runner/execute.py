@@ -3,37 +3,29 @@
 from __future__ import annotations
 
 import contextlib
-import platform
 import time
-from collections.abc import Callable, Iterator, Mapping, Sequence
-from importlib.metadata import version
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
-from typing import Any
 
 from adapters.unity.server import UnityOptions
 from cosim.core.adapter import AdapterType
 from cosim.core.errors import BridgeError, CosimError, ExportError, RegistryError
-from cosim.core.plugins import PluginError, refuse
-from cosim.core.recorder import merge_counts
 from cosim.core.registry import AdapterRegistry
 from cosim.core.timebase import NS_PER_S, s_to_ns
-from cosim.recording.dataframes import run_frames
 from cosim.recording.foxglove import LiveOptions
 from cosim.recording.setup import RecordingPlan, RecordingSession
 from cosim.runner.arguments import run_arguments
 from cosim.runner.assembly import Assembly, assemble
 from cosim.runner.compiletime import CompileClock
+from cosim.runner.conclusion import close_adapters, conclude
 from cosim.runner.faults import (
     Hung,
-    InternalError,
     fault_of,
     plugin_faults_named,
 )
-from cosim.runner.lateness import record_lateness
 from cosim.runner.outfolder import prepare_out, write_kept, write_run
-from cosim.runner.provenance import run_plugins
 from cosim.runner.result import RunResult
-from cosim.runner.stopping import CHECK_EVERY_S, RunStopped, StopRequest, signal_name
+from cosim.runner.stopping import CHECK_EVERY_S, RunStopped, StopRequest
 from cosim.runner.watchdog import Watchdog
 from cosim.scenario.loader import check_runnable
 from cosim.scenario.model import Scenario
@@ -43,11 +35,6 @@ ProgressFn = Callable[[float, float, float], None]
 
 PROGRESS_EVERY_S = 0.5
 """Wall-clock seconds between progress calls."""
-
-
-def cosim_version() -> str:
-    """The installed cosim version."""
-    return version("cosim")
 
 
 def execute(
@@ -264,104 +251,23 @@ def _run_assembled(
         halted, events = True, run.kernel.events_processed - counted
         failure = fault_of(error, doing=doing, t_ns=run.kernel.now_ns)
     finally:
-        run.workers.close()
-        for name, adapter in assembly.adapters:
-            close = getattr(adapter, "close", None)
-            if close is None:
-                continue
-            try:
-                close()
-            except Exception as error:
-                if failure is None:
-                    failure = fault_of(error, doing=f"closing adapter {name!r}", t_ns=None)
+        failure = close_adapters(assembly, failure)
     if failure is not None:
         halted = True
     # the run loop's own time: the first run on a machine compiles numba's kernels in it
     compiling_s = clock.seconds - compiled_before_s if clock is not None else 0.0
     wall_s = max(time.perf_counter() - wall_start - compiling_s, 0.0)
     reached_s = run.kernel.now_ns / NS_PER_S if halted else duration_s
-    counts = run.recorder.counts
-    sent = sum(counts.values())
-    summary: dict[str, Any] = {
-        "scenario": scenario.name,
-        "source": scenario.source,
-        "seed": scenario.seed,
-        "version": cosim_version(),
-        "python": platform.python_version(),
-        "plugins": run_plugins(scenario, assembly),
-        "sim_time_s": reached_s,
-        "wall_time_s": round(wall_s, 4),
-        "real_time_factor": round(reached_s / wall_s, 2) if wall_s > 0 else None,
-        "events": events,
-        **run.workers.summary(wall_s),
-        "messages_sent": sent,
-        "messages_delivered": counts["delivered"],
-        "messages_dropped": sent - counts["delivered"],
-        "network_messages": run.recorder.network_messages,
-        "network_bytes": run.recorder.network_bytes,
-    }
-    now_ns = run.kernel.now_ns
     stopped = stop.signum if halted and stop is not None and stop.signum is not None else None
-    if stopped is not None:
-        # a run that did not reach its duration says so before anything else
-        summary = {"stopped": signal_name(stopped), "planned_duration_s": duration_s, **summary}
-    if run.kernel.lateness is not None:
-        summary.update(record_lateness(run.kernel.lateness, run.recorder))
-    unfinished = []
-    for name, adapter in assembly.adapters:
-        try:
-            with Watchdog(scenario.scenario.hang_timeout_s):
-                metrics = adapter.finish(run)
-            if not isinstance(metrics, Mapping):
-                raise refuse(
-                    adapter,
-                    f"finish() returned {type(metrics).__name__}; expected a mapping of "
-                    "summary metrics (dict)",
-                )
-            merge_counts(summary, metrics)
-        except ValueError as error:  # a summary key given twice
-            failure = failure or refuse(adapter, f"finish(): {error}").at(run.kernel.now_ns)
-            unfinished.append(name)
-        except (Exception, Hung) as error:
-            unfinished.append(name)
-            if failure is None:  # once a run failed, adapters may fail to sum it up
-                failure = fault_of(error, doing=f"finishing adapter {name!r}", t_ns=now_ns)
-    if failure is not None:
-        summary = {**failure_summary(failure, duration_s, unfinished), **summary}
-    return RunResult(
+    return conclude(
         scenario,
-        summary,
-        run_frames(run.recorder),
-        volatile=run.recorder.volatile,
-        maps=dict(run.recorder.maps),
-        files=dict(run.recorder.files),
-        stopped=stopped,
+        assembly,
+        reached_s=reached_s,
+        wall_s=wall_s,
+        events=events,
         failure=failure,
+        stopped=stopped,
     )
-
-
-def failure_summary(failure: CosimError, planned_s: float, unfinished: list[str]) -> dict[str, Any]:
-    """The summary keys of a failed run, first: what failed, whose fault, what is missing.
-
-    ``failed`` is the one-line error; ``failure`` says whose fault it was (``plugin``,
-    ``cosim`` or ``external``/``input``), the plugin, and the adapters whose metrics are
-    missing because their ``finish`` failed after the fault.
-    """
-    if isinstance(failure, PluginError):
-        kind = "plugin"
-    elif isinstance(failure, InternalError):
-        kind = "cosim"
-    elif isinstance(failure, BridgeError | ExportError):
-        kind = "external"
-    else:
-        kind = "input"
-    detail: dict[str, Any] = {"kind": kind}
-    plugin = getattr(failure, "plugin", None)
-    if plugin is not None:
-        detail["plugin"] = plugin.as_dict()
-    if unfinished:
-        detail["unfinished_adapters"] = unfinished
-    return {"failed": str(failure), "failure": detail, "planned_duration_s": planned_s}
 
 
 def run(

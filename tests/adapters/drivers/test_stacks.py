@@ -14,6 +14,7 @@ BUILT_IN = {
     "waypoints": stacks.WAYPOINTS,
     "wander": stacks.WANDER,
     "teleop": stacks.TELEOP,
+    "agents": stacks.AGENTS,
 }
 
 
@@ -36,11 +37,12 @@ def test_the_drivers_run_their_own_adapters():
     assert stacks.WAYPOINTS.adapters == ("waypoints",)
     assert stacks.WANDER.adapters == ("wander",)
     assert stacks.TELEOP.adapters == ("teleop",)
+    assert stacks.AGENTS.adapters == ("agents",)
 
 
 def test_only_drivers_that_avoid_nothing_run_without_a_lidar():
     blind = {name for name, driver in BUILT_IN.items() if not driver.needs_lidar}
-    assert blind == {"waypoints", "teleop"}
+    assert blind == {"waypoints", "teleop", "agents"}  # a policy decides what to avoid
 
 
 @pytest.mark.parametrize("name", ["navigation", "tasks", "wander"])
@@ -52,7 +54,7 @@ def test_a_driver_that_avoids_what_the_lidar_sees_is_refused_without_beams(name)
         adapter_names(scenario)
 
 
-@pytest.mark.parametrize("name", ["waypoints", "teleop"])
+@pytest.mark.parametrize("name", ["waypoints", "teleop", "agents"])
 def test_a_driver_that_avoids_nothing_runs_without_a_lidar(name):
     scenario = cosim.load_scenario(
         "warehouse-random", {**SMALL, "robots.driver": name, "lidar.beams": 0}

@@ -57,10 +57,11 @@ REGISTRY = (
 )
 
 
-def _run(positions, extra=()):
+def _run(positions, extra=(), **more):
     scenario = cosim.load_scenario(
         "warehouse-random",
         overrides={
+            **more,
             "scenario.duration_s": 8.0,
             "world.size_m": [10.0, 10.0],
             "world.shelf_count": 0,
@@ -88,6 +89,14 @@ def test_a_robot_driving_into_a_wall_stops_at_it_and_never_passes_through():
     assert 0 <= result.summary["min_clearance_m"] < 0.06
     events = result.tables["events"]
     assert (events["kind"] == "collision").sum() == 1
+
+
+def test_a_robot_driving_into_a_given_obstacle_is_held_and_the_obstacle_named():
+    result = _run([[5.0, 5.0, 0.0]], **{"world.obstacles": [[7.0, 4.0, 8.0, 6.0]]})
+    collisions = result.tables["collisions"]
+    assert list(collisions["kind"]) == ["obstacle"]
+    assert collisions["other"].iloc[0] == "obstacle_0"
+    assert result.tables["poses"]["x_m"].max() <= 7.0 - 0.33 + 1e-12
 
 
 def test_two_robots_head_on_both_stop_without_overlapping():

@@ -207,3 +207,30 @@ def test_after_event_runs_once_the_event_is_done_before_any_other(realtime):
     kernel.at(10, lambda: log.append("second"), stage=Stage.CONTROL)
     kernel.run(100)
     assert log == ["asked before the run", "first", "after first", "after after", "second"]
+
+
+def test_advance_stops_after_the_whole_instant_that_woke_it():
+    kernel = Kernel()
+    order: list[tuple[int, str]] = []
+    woke = [False]
+
+    def wake() -> None:
+        order.append((kernel.now_ns, "wake"))
+        woke[0] = True
+
+    kernel.at(30, wake, Stage.DELIVERY)
+    kernel.at(30, lambda: order.append((30, "control")), Stage.CONTROL)
+    kernel.at(40, lambda: order.append((40, "later")), Stage.CONTROL)
+    processed = kernel.advance(100, lambda: woke[0])
+    assert kernel.now_ns == 30
+    assert order == [(30, "wake"), (30, "control")]
+    assert processed == 2
+    woke[0] = False
+    kernel.advance(100, lambda: woke[0])
+    assert kernel.now_ns == 100
+    assert order[-1] == (40, "later")
+
+
+def test_advance_refuses_a_real_time_kernel():
+    with pytest.raises(ValueError, match="real time"):
+        Kernel(realtime=True).advance(10, lambda: False)

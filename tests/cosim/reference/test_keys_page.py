@@ -218,7 +218,8 @@ def test_a_key_naming_an_implementation_lists_the_registered_names_and_its_off_v
     driver = rows["robots"]["driver"][1]
     assert driver.startswith("a registered robot driver: ")
     assert {"navigation", "tasks", "waypoints", "wander"} <= set(driver.split(": ")[1].split(", "))
-    assert re.search(r"^\| `driver` \| .*\| a registered robot driver: `navigation`, ", page, re.M)
+    listed = r"^\| `driver` \| .*\| a registered robot driver: `agents`, `navigation`, "
+    assert re.search(listed, page, re.M)
     source = rows["mocap"]["source"][1]
     assert "simulated" in source and source.endswith(", or none (none at all)")
     assert rows["mocap"]["source"][0] == '"none"'

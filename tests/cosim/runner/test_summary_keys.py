@@ -42,6 +42,7 @@ TOGGLES = {
     "teleop driver": {"robots.driver": "teleop"},
     "waypoints driver": {"robots.driver": "waypoints"},
     "navigation driver": {"robots.driver": "navigation"},
+    "agents driver": {"robots.driver": "agents"},
     "cbba": {"assignment.protocol": "cbba"},
     "greedy": {"assignment.protocol": "greedy"},
     "hungarian": {"assignment.protocol": "hungarian"},

@@ -1,0 +1,1 @@
+"""Learning agents: robots a Gymnasium or PettingZoo environment drives (``[agents]``)."""

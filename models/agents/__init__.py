@@ -1,0 +1,1 @@
+"""What learning agents observe, computed for every agent at once: frames and sectors."""
