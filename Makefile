@@ -14,7 +14,7 @@ STUDY = $(BIN)/cosim study studies/$(1).toml --out $(STUDIES)/$(1) --resume
 	study-burst study-scale study-paper study-nav study-mapping study-mapping-reduced \
 	study-mapping-acceptance study-mapping-defaults study-mapping-drift map-aces map-fr079 \
 	lab-real lab-mixed study-humans study-humans-reduced study-humans-contacts study-traffic \
-	study-local-replanning study-local-replanning-network study-radio
+	study-local-replanning study-local-replanning-network study-radio rl train-agent study-agents
 
 help:  ## list the targets
 	@grep -E '^[a-z-]+:.*##' $(MAKEFILE_LIST) | sed 's/:.*## /\t/'
@@ -39,6 +39,15 @@ $(NS3_STAMP): $(STAMP)
 	touch $(NS3_STAMP)
 
 ns3: $(NS3_STAMP)  ## install the ns3 extra (network.backend = "ns3") into .venv
+
+# the learning tutorial's trainer (the `rl` extra: Stable-Baselines3 and PyTorch); `make test`
+# does not install it (its tests of a trained model are skipped without it)
+RL_STAMP := $(VENV)/.installed-rl
+$(RL_STAMP): $(STAMP)
+	$(BIN)/python -m pip install --quiet -e '.[dev,rl]'
+	touch $(RL_STAMP)
+
+rl: $(RL_STAMP)  ## install the rl extra (Stable-Baselines3, PyTorch) into .venv
 
 # ARGS: more arguments of the run of demo, lab-real and lab-mixed (ARGS='--seed 3 --duration-s 30')
 demo: setup  ## run the default scenario and say where the results are
@@ -124,6 +133,12 @@ study-local-replanning: setup  ## every controller x planner on warehouse-humans
 
 study-radio: setup ns3  ## the built-in network model against an ns-3 radio, 4/20/50 robots x few/many shelves, 2 seeds x 60 s
 	$(call STUDY,radio)
+
+train-agent: rl  ## the learning tutorial: PPO on cosim/Warehouse-v0, 400k steps in 8 environments (about 10 min) -> studies/policies, studies/results/agents_training
+	$(BIN)/python studies/train_agent.py --steps 400000
+
+study-agents: rl  ## the learnt policy against cosim's navigation and a random policy in the lab room, 8 seeds x 60 s
+	$(call STUDY,agents)
 
 study-local-replanning-network: setup  ## dwa and orca in the lab room over network latency and loss, 4 seeds x 120 s (about 2 min)
 	$(call STUDY,local_replanning_network)

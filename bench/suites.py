@@ -13,6 +13,7 @@ from breakdown_bench import whole_stack_breakdown
 from cases import EVERY_ROBOT_PLANS, FULL_STACK
 from controllers_bench import controllers_fleet50, planners_fleet50
 from dwa_bench import dwa_us_per_robot
+from envs_bench import envs_steps
 from humans_bench import humans_coupling
 from landmarks_bench import landmark_savings
 from lidar_bench import lidar_rays_per_second
@@ -415,6 +416,7 @@ SUITES: dict[str, Callable[[int], Result]] = {
     "network": network_deliveries_per_second,
     "network_end_to_end": network_end_to_end,
     "ns3_radio": ns3_radio,
+    "envs": envs_steps,
     "planner": planner_ms,
     "fleet50_navigation": fleet50_navigation,
     "fleet50_full_stack": fleet50_full_stack,

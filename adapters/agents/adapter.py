@@ -23,7 +23,16 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from adapters.agents.contract import ACTIONS, OBSERVATIONS, REWARDS, AgentParts, AgentView
+from adapters.agents.boundary import action_problem, observe_all
+from adapters.agents.contract import (
+    ACTIONS,
+    OBSERVATIONS,
+    POLICIES,
+    REWARDS,
+    AgentParts,
+    AgentView,
+    Policy,
+)
 from adapters.agents.settings import AgentsConfig
 from adapters.fleet.collisions import ContactCounts
 from adapters.fleet.motion import drive_limits
@@ -36,11 +45,12 @@ from cosim.core.bus import Envelope
 from cosim.core.hosts import HostId
 from cosim.core.kernel import Stage
 from cosim.core.messages import LaserScan, Message, RobotState
+from cosim.core.plugins import refuse
 from cosim.core.summary import SummaryKey
 from cosim.core.table import TableSpec
 from cosim.core.timebase import NS_PER_S, period_ns
 from cosim.scenario.sections import LidarConfig, RobotsConfig, WorldConfig
-from models.arrays import FloatArray
+from models.arrays import Float32Array, FloatArray, IntArray
 from models.fleet.kinematics import FleetState
 
 AGENT_STATES = "/agents/states"
@@ -89,7 +99,9 @@ class AgentsAdapter:
         self.series = run.settings(NavigationConfig).goals
         self.movable = np.array([bool(len(c)) or bool(self.series) for c in self.cells], dtype=bool)
         """Robots with somewhere to go (one walled in stays, and never arrives)."""
-        self.rngs = [run.rng.stream(f"agents/goals/{name}") for name in names]
+        # the goals adapter's streams and rule: with the same seed, cosim's own navigation
+        # (robots.driver = "navigation") is sent to the same goals in the same order
+        self.rngs = [run.rng.stream(f"goals/{name}") for name in names]
         kind = ACTIONS.installed().get(cfg.action)
         self.at_places = bool(getattr(kind, "goals_at_places", False))
         width, height = run.settings(WorldConfig).size_m
@@ -135,6 +147,11 @@ class AgentsAdapter:
             weights=np.array(weights, dtype=float),
         )
         run.provide(self.parts)
+        self.size = sum(len(part.low) for part in self.parts.observations)
+        self.policy: Policy | None = None
+        if cfg.policy != "none":
+            policy = POLICIES.installed().get(cfg.policy)
+            self.policy = policy(self.view, self.parts, self.size)
 
     def _places(self, run: RunContext, count: int) -> FloatArray:
         """The places an agent may choose: ``navigation.goals``, else free cells drawn once."""
@@ -181,6 +198,28 @@ class AgentsAdapter:
         run.kernel.every(physics, lambda now: self._arrivals(run, now), stage=Stage.SENSING)
         if "contact" in self.cfg.wake_on:
             self._contacts_seen = self.view.contacts.copy()
+        if self.policy is not None:
+            observations = np.zeros((len(self.view), self.size), dtype=np.float32)
+            everyone = np.arange(len(self.view))
+            run.kernel.every(
+                period_ns(self.cfg.decision_hz),
+                lambda now: self._decide(now, self.policy, observations, everyone),
+                stage=Stage.DECISION,
+            )
+
+    def _decide(
+        self, now_ns: int, policy: Policy | None, observations: Float32Array, everyone: IntArray
+    ) -> None:
+        """The policy's decision for every agent, checked, applied (a plain run's)."""
+        assert policy is not None
+        view = self.view
+        observe_all(self.parts, view, observations)
+        actions = np.asarray(policy.act(observations))
+        problem = action_problem(self.parts.action.spec, actions, view.names)
+        if problem is not None:
+            raise refuse(policy, f"act() returned {problem}").at(now_ns)
+        self.parts.action.apply(view, everyone, actions)
+        view.decided_ns[:] = now_ns
 
     def _on_state(self, run: RunContext, i: int) -> Callable[[Message, Envelope], None]:
         index = {name: j for j, name in enumerate(self.view.names)}

@@ -258,3 +258,43 @@ class AgentParts:
     observations: tuple[ObservationPart, ...]
     rewards: tuple[RewardTerm, ...]
     weights: FloatArray
+
+
+# -- policies -------------------------------------------------------------------------------
+class Policy(Protocol):
+    """What a ``cosim.agent_policies`` entry point names: a class built once per run.
+
+    A policy decides for every agent in a plain run (``cosim run``, a study), where no
+    learning environment does: at every decision the agents adapter observes, asks
+    :meth:`act`, checks the actions and applies them.
+
+    Attributes:
+        name: the registered name (``agents.policy``).
+    """
+
+    name: ClassVar[str]
+
+    def __init__(self, view: AgentView, parts: AgentParts, observation_size: int) -> None: ...
+
+    def act(self, observations: Float32Array) -> np.ndarray:
+        """Every agent's action for its observation (one row each, as the action's spec)."""
+        ...
+
+
+def _policy_contract(name: str, loaded: Any) -> str | None:
+    if not isinstance(loaded, type):
+        return "is not a class (built with an AgentView, the AgentParts and a size)"
+    if not callable(getattr(loaded, "act", None)):
+        return "has no act() method (see adapters.agents.contract.Policy)"
+    return None
+
+
+POLICIES = Group(
+    "cosim.agent_policies",
+    "agent policy",
+    "agent policies",
+    "`adapters.agents.contract` (`Policy`)",
+    "`agents.policy`",
+    check=_policy_contract,
+)
+"""Who decides for learning agents in a plain run (``agents.policy``)."""

@@ -15,6 +15,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import ClassVar, Literal
 
+from cosim.scenario.choices import choice_problems
 from cosim.scenario.fields import Problem, param
 
 Wake = Literal["arrival", "message", "contact"]
@@ -70,7 +71,10 @@ class AgentsConfig:
         "environment: agents decide one by one, not all at once)",
     )
     goal_tolerance_m: float = param(
-        0.3, "an agent within this distance of its goal has arrived (m)", gt=0, le=100
+        0.25,
+        "an agent within this distance of its goal has arrived (m): navigation's own default",
+        gt=0,
+        le=100,
     )
     lidar_bins: int = param(
         16,
@@ -93,6 +97,18 @@ class AgentsConfig:
         gt=0,
         le=3600,
     )
+    policy: str = param(
+        "none",
+        "who decides in a plain run (cosim run, a study): 'none' (an environment of cosim.envs "
+        "decides; without one the robots stand still), 'random', or 'sb3' (a trained "
+        "Stable-Baselines3 model) (cosim.agent_policies)",
+        registry="cosim.agent_policies",
+        off="none",
+    )
+    policy_file: str = param("", "sb3 policy: the model file (saved by model.save)", path=True)
+    sb3_algorithm: str = param(
+        "PPO", "sb3 policy: the model's Stable-Baselines3 class (PPO, A2C, SAC, TD3, DQN)"
+    )
     places: int = param(
         8,
         "goal action: the places an agent can choose among (drawn per episode)",
@@ -102,7 +118,8 @@ class AgentsConfig:
     )
 
     def problems(self) -> Iterator[Problem]:
-        """A weight for every reward term; a part observed once."""
+        """A weight for every reward term; a part observed once; what the policy needs."""
+        yield from choice_problems(self, "policy")
         if self.reward_weights and len(self.reward_weights) != len(self.rewards):
             yield Problem(
                 "reward_weights",

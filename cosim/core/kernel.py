@@ -62,6 +62,10 @@ _STEP = simpy.Environment.step.__code__
 class Stage(IntEnum):
     """Order of events that fall on the same nanosecond (lower runs first)."""
 
+    DECISION = 1
+    """A learning agent's policy deciding on the instant as it stood before it (its actions
+    go out in ``CONTROL``), as a learning environment observes between two kernel steps.
+    It shares SimPy's ``NORMAL`` priority, which cosim's own events do not use."""
     PHYSICS = 2
     """Kinematics integration and ground-truth contact checks."""
     EXTERNAL = 3

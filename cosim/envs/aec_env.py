@@ -13,16 +13,17 @@ from __future__ import annotations
 from collections.abc import Mapping
 from functools import cache
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any
 
 import gymnasium
 import numpy as np
 from pettingzoo import AECEnv
 
 from cosim.envs.agents import SEED_LIMIT, Agents
+from cosim.envs.rendering import frame
 from cosim.runner.result import RunResult
 from cosim.scenario.model import Scenario
-from models.arrays import Float32Array
+from models.arrays import Float32Array, UInt8Array
 
 
 class WarehouseAECEnv(AECEnv[str, Float32Array, Any]):
@@ -32,10 +33,13 @@ class WarehouseAECEnv(AECEnv[str, Float32Array, Any]):
         scenario: a preset name, a scenario file, or a loaded scenario.
         overrides: ``{"section.key": value}`` on top of a preset or file.
         duration_s: an episode's simulated length (s); the scenario's if None.
-        render_mode: None (the run's tables and figures are its pictures).
+        render_mode: None, or ``"rgb_array"`` (:meth:`render` draws the room from above).
     """
 
-    metadata: ClassVar[dict[str, Any]] = {"name": "cosim_warehouse_aec_v0", "render_modes": []}
+    metadata: dict[str, Any] = {  # noqa: RUF012 (PettingZoo's own field; render_fps per env)
+        "name": "cosim_warehouse_aec_v0",
+        "render_modes": ["rgb_array"],
+    }
 
     def __init__(
         self,
@@ -45,10 +49,11 @@ class WarehouseAECEnv(AECEnv[str, Float32Array, Any]):
         render_mode: str | None = None,
     ) -> None:
         super().__init__()
-        if render_mode is not None:
-            raise ValueError(f"render_mode={render_mode!r}: expected None (see result())")
+        if render_mode not in (None, "rgb_array"):
+            raise ValueError(f"render_mode={render_mode!r}: expected None or 'rgb_array'")
         self.render_mode = render_mode
         self.core = Agents(scenario, overrides, duration_s)
+        self.metadata = {**self.metadata, "render_fps": self.core.settings.decision_hz}
         self.possible_agents = list(self.core.names)
         self.index = {a: i for i, a in enumerate(self.possible_agents)}
         self.observation_spaces = {a: self.core.observation_space for a in self.possible_agents}
@@ -113,9 +118,11 @@ class WarehouseAECEnv(AECEnv[str, Float32Array, Any]):
         self.agent_selection = nxt
         self._accumulate_rewards()
 
-    def render(self) -> None:
-        """Nothing to draw (render_mode None): the run's tables and figures are its pictures."""
-        return None
+    def render(self) -> UInt8Array | None:
+        """The room from above (``render_mode="rgb_array"``), else None."""
+        if self.render_mode != "rgb_array":
+            return None
+        return frame(self.core.episode.view)
 
     def state(self) -> Float32Array:
         """Every agent's observation, stacked (agents, size)."""

@@ -100,8 +100,8 @@ class Agents:
         if seed is not None and not (isinstance(seed, int) and not isinstance(seed, bool)):
             raise ArgumentError(f"reset(seed={seed!r}): expected an int >= 0 or None")
         scenario = self.base if seed is None else self.base.with_seed(seed)
-        if self.fresh and scenario.seed == self.episode.scenario.seed:
-            return
+        if self.fresh and not self.episode.closed and scenario.seed == self.episode.scenario.seed:
+            return  # the episode built for this seed has not moved yet: it is the new one
         self.finish()
         self.episode = Episode(scenario)
         self.fresh = True

@@ -15,13 +15,13 @@ from typing import Any, NoReturn
 
 import numpy as np
 
+from adapters.agents.boundary import action_problem, observe_all, reward_totals
 from adapters.agents.contract import ACTIONS, AgentParts, AgentView
 from adapters.agents.settings import AgentsConfig
-from cosim.core.errors import BridgeError, CosimError, ExportError
-from cosim.core.plugins import refuse
+from cosim.core.errors import BridgeError, ConfigError, CosimError, ExportError
+from cosim.core.plugins import PluginError
 from cosim.core.registry import AdapterRegistry
 from cosim.core.timebase import NS_PER_S, s_to_ns
-from cosim.envs.boundary import action_problem, observation_problem, reward_problem
 from cosim.runner.assembly import Assembly, assemble
 from cosim.runner.conclusion import close_adapters, conclude
 from cosim.runner.faults import Hung, fault_of, plugin_faults_named
@@ -62,6 +62,12 @@ def agents_scenario(
         base = scenario
     else:
         base = load_scenario(scenario, dict(overrides or {}), override_origin="overrides")
+    policy = base.section(AgentsConfig).policy
+    if policy != "none":
+        raise ConfigError(
+            f"{base.source}: [agents] policy = {policy!r}: expected 'none' in an environment "
+            "(the environment's caller decides; a policy decides in cosim run and studies)"
+        )
     base = base.with_section("robots", replace(base.robots, driver=DRIVER))
     kind = ACTIONS.installed().get(base.section(AgentsConfig).action)
     needed = [name for name in kind.adapters if name not in base.scenario.adapters]
@@ -113,6 +119,11 @@ class Episode:
         return self.assembly.run.kernel.now_ns
 
     @property
+    def closed(self) -> bool:
+        """Whether the run was closed (its result gathered, or failed)."""
+        return self._closed
+
+    @property
     def ended(self) -> bool:
         """Whether the run reached its duration (or was closed)."""
         return self._closed or self.now_ns >= self.end_ns
@@ -146,33 +157,21 @@ class Episode:
             PluginError: a part raised, or wrote a value outside its declared bounds (or
                 NaN); the run is closed, what ran kept.
         """
-        column, view = 0, self.view
-        for part in self.parts.observations:
-            size = len(part.low)
-            block = out[:, column : column + size]
-            try:
-                part.observe(view, block)
-            except (Exception, Hung) as error:
-                self._fail(fault_of(error, doing="observing", t_ns=self.now_ns))
-            problem = observation_problem(block, part.low, part.high, view.names)
-            if problem is not None:
-                self._fail(refuse(part, problem).at(self.now_ns))
-            column += size
+        try:
+            observe_all(self.parts, self.view, out)
+        except PluginError as error:
+            self._fail(error)
+        except (Exception, Hung) as error:
+            self._fail(fault_of(error, doing="observing", t_ns=self.now_ns))
 
     def _reward_totals(self) -> FloatArray:
         """(terms, agents) running totals of the reward terms."""
-        n = len(self.view)
-        totals = np.zeros((len(self.parts.rewards), n))
-        for k, term in enumerate(self.parts.rewards):
-            try:
-                total = term.total(self.view)
-            except (Exception, Hung) as error:
-                self._fail(fault_of(error, doing="rewarding", t_ns=self.now_ns))
-            problem = reward_problem(total, n)
-            if problem is not None:
-                self._fail(refuse(term, problem).at(self.now_ns))
-            totals[k] = total
-        return totals
+        try:
+            return reward_totals(self.parts, self.view)
+        except PluginError as error:
+            self._fail(error)
+        except (Exception, Hung) as error:
+            self._fail(fault_of(error, doing="rewarding", t_ns=self.now_ns))
 
     def act(self, agents: IntArray, actions: np.ndarray) -> None:
         """Apply the actions of ``agents`` (indices), one row each.

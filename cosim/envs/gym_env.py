@@ -16,9 +16,10 @@ import gymnasium
 import numpy as np
 
 from cosim.envs.agents import SEED_LIMIT, Agents
+from cosim.envs.rendering import frame
 from cosim.runner.result import RunResult
 from cosim.scenario.model import Scenario
-from models.arrays import Float32Array
+from models.arrays import Float32Array, UInt8Array
 
 
 class WarehouseEnv(gymnasium.Env[Float32Array, np.ndarray]):
@@ -29,11 +30,12 @@ class WarehouseEnv(gymnasium.Env[Float32Array, np.ndarray]):
         overrides: ``{"section.key": value}`` on top of a preset or file (``[agents]`` keys
             choose what the robots see, do and are rewarded for).
         duration_s: an episode's simulated length (s); the scenario's if None.
-        render_mode: None (the run's tables and figures are its pictures:
-            :meth:`result`).
+        render_mode: None, or ``"rgb_array"``: :meth:`render` draws the room from above
+            (:mod:`cosim.envs.rendering`); the run's tables and figures are in
+            :meth:`result` either way.
     """
 
-    metadata: dict[str, Any] = {"render_modes": []}  # noqa: RUF012 (Gymnasium's own field)
+    metadata: dict[str, Any] = {"render_modes": ["rgb_array"]}  # noqa: RUF012 (Gymnasium's own)
 
     def __init__(
         self,
@@ -42,9 +44,11 @@ class WarehouseEnv(gymnasium.Env[Float32Array, np.ndarray]):
         duration_s: float | None = None,
         render_mode: str | None = None,
     ) -> None:
-        if render_mode is not None:
-            raise ValueError(f"render_mode={render_mode!r}: expected None (see result())")
+        if render_mode not in (None, *self.metadata["render_modes"]):
+            raise ValueError(f"render_mode={render_mode!r}: expected None or 'rgb_array'")
+        self.render_mode = render_mode
         self.agents = Agents(scenario, overrides, duration_s)
+        self.metadata = {**self.metadata, "render_fps": self.agents.settings.decision_hz}
         n = len(self.agents)
         one_obs, one_action = self.agents.observation_space, self.agents.action_space
         self.observation_space = gymnasium.spaces.Box(
@@ -79,6 +83,12 @@ class WarehouseEnv(gymnasium.Env[Float32Array, np.ndarray]):
         info = self.agents.info()
         info["rewards"] = rewards
         return self.agents.observe().copy(), float(rewards.sum()), False, self.agents.ended, info
+
+    def render(self) -> UInt8Array | None:
+        """The room from above (``render_mode="rgb_array"``), else None."""
+        if self.render_mode != "rgb_array":
+            return None
+        return frame(self.agents.episode.view)
 
     def result(self) -> RunResult:
         """The episode's run: its summary and tables (``result().tables["poses"]``).

@@ -34,8 +34,24 @@ def _wall_us_per_robot_s(results: pd.DataFrame) -> pd.Series:
     return 1e6 * results["wall_time_s"].astype(float) / robot_s.where(robot_s > 0)
 
 
+def _goals_per_min(results: pd.DataFrame) -> pd.Series:
+    reached = pd.Series(float("nan"), index=results.index)
+    for column in ("arrivals", "agent_arrivals"):  # a learning agent's own count wins
+        if column in results.columns:
+            counted = results[column].astype(float)
+            reached = counted.where(counted.notna(), reached)
+    minutes = results["sim_time_s"].astype(float) / 60.0
+    return reached / minutes.where(minutes > 0)
+
+
 DERIVED_METRICS: Mapping[str, DerivedMetric] = MappingProxyType(
     {
+        "goals_per_min": DerivedMetric(
+            inputs=("sim_time_s",),
+            formula="goals reached per minute: agent_arrivals (learning agents' goals) or "
+            "else arrivals (the navigation's), / (sim_time_s / 60)",
+            compute=_goals_per_min,
+        ),
         "wall_us_per_robot_s": DerivedMetric(
             inputs=("wall_time_s", "robots", "sim_time_s"),
             formula="wall-clock microseconds per simulated robot-second, "

@@ -99,6 +99,18 @@ def the_stand_in_runs_leave_their_figures_and_their_domain(page: PageRun) -> Non
         assert _summary(page, f"runs/{run}")["physical_dds_domain"] is not None
 
 
+def the_hand_written_policy_reaches_goals_and_the_learnt_one_beats_random(page: PageRun) -> None:
+    ran = page.python_ran()[-1]
+    goals = re.findall(r"(\d+) goals, \d+ contacts", ran.stdout)[-1]
+    assert int(goals) >= 3, ran.told()  # the task can be done in 30 s
+    curve = pd.read_csv(REPO / "studies" / "results" / "agents_training" / "learning_curve.csv")
+    last = curve.iloc[-1]
+    assert last["goals_per_min"] > 4 * last["random"]  # the committed figure's claim
+    study = pd.read_parquet(REPO / "studies" / "results" / "agents" / "results.parquet")
+    by_policy = study.groupby("agents.policy")["agent_arrivals"].mean()
+    assert by_policy["sb3"] > 10 * by_policy["random"]
+
+
 PROMISES: dict[str, tuple[Callable[[PageRun], None], ...]] = {
     "tutorials/write-an-adapter.md": (
         battery_takes_its_settings_and_records_its_table,
@@ -108,6 +120,9 @@ PROMISES: dict[str, tuple[Callable[[PageRun], None], ...]] = {
     "tutorials/write-a-controller.md": (turn_then_go_drives_robots_to_their_goals_within_limits,),
     "tutorials/run-a-study.md": (the_study_writes_its_report_and_its_analysis_prints_intervals,),
     "tutorials/physical-robot.md": (the_stand_in_runs_leave_their_figures_and_their_domain,),
+    "tutorials/train-an-agent.md": (
+        the_hand_written_policy_reaches_goals_and_the_learnt_one_beats_random,
+    ),
 }
 """What each tutorial's slow part must show once its blocks ran."""
 

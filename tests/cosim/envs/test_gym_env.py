@@ -97,3 +97,13 @@ def test_a_bad_override_is_refused_naming_the_key_and_what_was_expected():
         WarehouseEnv("lab-room", overrides={"lidar.beams": 0})
     with pytest.raises(ValueError, match="render_mode"):
         WarehouseEnv("lab-room", render_mode="human")
+
+
+def test_a_closed_episode_is_never_reused_by_the_next_reset():
+    env = WarehouseEnv("lab-room", duration_s=1.0)
+    env.reset(seed=3)
+    env.close()
+    env.reset(seed=3)
+    env.step(np.zeros((4, 2), np.float32))
+    assert env.agents.now_ns == 100_000_000
+    assert env.result().summary["sim_time_s"] == pytest.approx(0.1)

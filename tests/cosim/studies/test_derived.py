@@ -23,3 +23,20 @@ def test_a_derived_metric_names_the_summary_metrics_it_needs_and_cannot_be_repla
     assert "1e6 x wall_time_s / (robots x sim_time_s)" in metric.formula
     with pytest.raises(TypeError):
         DERIVED_METRICS["wall_us_per_robot_s"] = metric  # type: ignore[index]
+
+
+def test_goals_per_minute_counts_a_learning_agents_goals_or_else_the_navigations():
+    frame = pd.DataFrame(
+        {
+            "sim_time_s": [60.0, 30.0, 60.0, 0.0],
+            "arrivals": [5.0, float("nan"), 4.0, 1.0],
+            "agent_arrivals": [float("nan"), 3.0, 7.0, 1.0],
+        }
+    )
+    values = DERIVED_METRICS["goals_per_min"].compute(frame)
+    assert values.iloc[0] == 5.0  # the navigation driver's
+    assert values.iloc[1] == 6.0  # an agent's, in 30 s
+    assert values.iloc[2] == 7.0  # both counted (the goal action): the agent's goals
+    assert np.isnan(values.iloc[3])  # no time: undefined
+    only_navigation = DERIVED_METRICS["goals_per_min"].compute(frame[["sim_time_s", "arrivals"]])
+    assert only_navigation.iloc[2] == 4.0

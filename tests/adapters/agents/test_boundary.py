@@ -3,8 +3,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
+from adapters.agents.boundary import action_problem, observation_problem, reward_problem
 from adapters.agents.contract import BoxSpec, ChoiceSpec
-from cosim.envs.boundary import action_problem, observation_problem, reward_problem
 
 NAMES = ["robot_1", "robot_2"]
 BOX = BoxSpec((-0.3, -2.0), (0.5, 2.0), ("v_mps", "w_radps"))

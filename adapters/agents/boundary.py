@@ -11,8 +11,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from adapters.agents.contract import BoxSpec, ChoiceSpec
-from models.arrays import FloatArray
+from adapters.agents.contract import AgentParts, AgentView, BoxSpec, ChoiceSpec
+from cosim.core.plugins import refuse
+from models.arrays import Float32Array, FloatArray
 
 
 def observation_problem(
@@ -70,3 +71,38 @@ def action_problem(
         return None
     i = int(np.flatnonzero(~finite)[0])
     return f"action {actions[i].tolist()!r} for {names[i]}: expected finite numbers ({what})"
+
+
+def observe_all(parts: AgentParts, view: AgentView, out: Float32Array) -> None:
+    """Write every agent's observation into ``out`` (agents, size), part after part.
+
+    Raises:
+        PluginError: a part wrote a value outside its declared bounds, or NaN.
+        Exception: what a part's own code raised, as it was raised.
+    """
+    column = 0
+    for part in parts.observations:
+        size = len(part.low)
+        block = out[:, column : column + size]
+        part.observe(view, block)
+        problem = observation_problem(block, part.low, part.high, view.names)
+        if problem is not None:
+            raise refuse(part, problem).at(view.now_ns)
+        column += size
+
+
+def reward_totals(parts: AgentParts, view: AgentView) -> FloatArray:
+    """(terms, agents) running totals of every reward term.
+
+    Raises:
+        PluginError: a term handed back the wrong shape, or values that are not finite.
+        Exception: what a term's own code raised, as it was raised.
+    """
+    totals = np.zeros((len(parts.rewards), len(view)))
+    for k, term in enumerate(parts.rewards):
+        total = term.total(view)
+        problem = reward_problem(total, len(view))
+        if problem is not None:
+            raise refuse(term, problem).at(view.now_ns)
+        totals[k] = total
+    return totals
