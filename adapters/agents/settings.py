@@ -15,6 +15,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import ClassVar, Literal
 
+from cosim.core.registry import group_named
 from cosim.scenario.choices import choice_problems
 from cosim.scenario.fields import Problem, param
 
@@ -116,6 +117,11 @@ class AgentsConfig:
         le=256,
         unit="count",
     )
+
+    def adapters(self) -> list[str]:
+        """What the action kind needs besides the ``agents`` adapter (``navigation``)."""
+        kind = group_named("cosim.agent_actions").installed().get(self.action)
+        return list(getattr(kind, "adapters", ()))
 
     def problems(self) -> Iterator[Problem]:
         """A weight for every reward term; a part observed once; what the policy needs."""

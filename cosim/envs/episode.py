@@ -16,7 +16,7 @@ from typing import Any, NoReturn
 import numpy as np
 
 from adapters.agents.boundary import action_problem, observe_all, reward_totals
-from adapters.agents.contract import ACTIONS, AgentParts, AgentView
+from adapters.agents.contract import AgentParts, AgentView
 from adapters.agents.settings import AgentsConfig
 from cosim.core.errors import BridgeError, ConfigError, CosimError, ExportError
 from cosim.core.plugins import PluginError
@@ -46,8 +46,8 @@ def agents_scenario(
             ``robots.count``, ...); a loaded scenario takes none (load it with them).
 
     Returns:
-        The scenario with ``robots.driver = "agents"`` and the adapters its action kind
-        needs (``navigation`` for ``goal``) added to ``scenario.adapters``.
+        The scenario with ``robots.driver = "agents"`` (``[agents]`` adds what its action
+        kind needs: ``navigation`` for ``goal``).
 
     Raises:
         ConfigError: a bad file, key or value (named as ``cosim run`` names it).
@@ -69,11 +69,6 @@ def agents_scenario(
             "(the environment's caller decides; a policy decides in cosim run and studies)"
         )
     base = base.with_section("robots", replace(base.robots, driver=DRIVER))
-    kind = ACTIONS.installed().get(base.section(AgentsConfig).action)
-    needed = [name for name in kind.adapters if name not in base.scenario.adapters]
-    if needed:
-        adapters = (*base.scenario.adapters, *needed)
-        base = base.with_section("scenario", replace(base.scenario, adapters=adapters))
     return base
 
 

@@ -56,6 +56,8 @@ class Trial:
 
 TASKS = {"robots.driver": "tasks"}
 NAVIGATION = {"robots.driver": "navigation"}
+AGENTS = {"robots.driver": "agents", "agents.policy": "random"}
+"""Learning agents deciding by themselves (a random policy), so their parts are used."""
 TRIALS: Mapping[str, Trial] = {
     "cosim.adapters": Trial({"robots.driver": "waypoints"}, 5.0),
     "cosim.drivers": Trial({}, 10.0, (finite,)),
@@ -69,6 +71,10 @@ TRIALS: Mapping[str, Trial] = {
     "cosim.topologies": Trial(TASKS, 10.0),
     "cosim.mocap_sources": Trial(NAVIGATION, 10.0, (tracks,)),
     "cosim.map_sharing": Trial({**NAVIGATION, "mapping.enabled": True}, 10.0),
+    "cosim.agent_observations": Trial(AGENTS, 10.0, (finite,)),
+    "cosim.agent_actions": Trial(AGENTS, 10.0, (finite,)),
+    "cosim.agent_rewards": Trial(AGENTS, 10.0, (finite,)),
+    "cosim.agent_policies": Trial({"robots.driver": "agents"}, 10.0, (finite, moves)),
 }
 """The trial of each of cosim's groups; a plugin's own group gets :data:`ANY_GROUP`."""
 ANY_GROUP = Trial({}, 10.0)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib.util
 import os
 import re
 import subprocess
@@ -42,6 +43,12 @@ def needs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, list[str]]:
         "cosim.mocap_sources:bag": [f"mocap.file='{track}'"],
         "cosim.topologies:explicit": ['network.edges=[["robot_1", "robot_2"]]'],
         "cosim.topologies:range": ["network.range_m=10.0"],
+        # the tutorial's model: one robot, its speed, goal and lidar sectors
+        "cosim.agent_policies:sb3": [
+            "robots.count=1",
+            "agents.observe=['velocity', 'goal', 'lidar']",
+            f"agents.policy_file='{REPO / 'studies' / 'policies' / 'lab_goals_ppo.zip'}'",
+        ],
     }
 
 
@@ -55,6 +62,11 @@ def test_the_built_ins_of_every_group_are_checked():
 
 @pytest.mark.parametrize("entry", BUILT_INS)
 def test_every_built_in_passes_check_plugin(entry, needs):
+    if (
+        entry == "cosim.agent_policies:sb3"
+        and importlib.util.find_spec("stable_baselines3") is None
+    ):
+        pytest.skip("the sb3 policy needs the rl extra (Stable-Baselines3), not installed here")
     args = [arg for setting in needs.get(entry, []) for arg in ("--set", setting)]
     done = cosim_main("check-plugin", entry, *args)
     assert done.returncode == 0, done.stdout + done.stderr
