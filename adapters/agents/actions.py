@@ -12,6 +12,7 @@ from typing import ClassVar
 import numpy as np
 
 from adapters.agents.contract import AgentView, BoxSpec, ChoiceSpec
+from adapters.assignment.settings import AssignmentConfig
 from adapters.fleet.topics import cmd_vel_topic
 from adapters.navigation.topics import goal_topic, status_topic
 from cosim.core.bus import Envelope
@@ -126,3 +127,33 @@ class GoalChoice:
             run.kernel.at(
                 now, lambda: run.bus.publish_many(topics, messages, hosts), stage=Stage.CONTROL
             )
+
+
+class Bid:
+    """``bid``: a bid in [0, 1] for each of the first ``agents.task_slots`` open tasks (0 declines).
+
+    The robots run the task assignment (task source, claims, navigation to the station,
+    service) with ``assignment.protocol = "agent_bids"``: once an agent has bid after a new
+    set of open tasks reached its robot, the robot claims the free task it bids highest for.
+    The ``tasks`` observation part shows the slots; the ``tasks`` reward term counts what
+    each agent's robot served.
+    """
+
+    name: ClassVar[str] = "bid"
+    adapters: ClassVar[tuple[str, ...]] = ("navigation", "task_source", "dta")
+    goals: ClassVar[bool] = False
+
+    def __init__(self, view: AgentView) -> None:
+        protocol = view.run.settings(AssignmentConfig).protocol
+        if protocol != "agent_bids":
+            raise ConfigError(
+                f"{view.run.scenario.source}: [assignment] protocol = {protocol!r}: expected "
+                "'agent_bids' with agents.action = 'bid' (the protocol that takes the bids)"
+            )
+        slots = view.settings.task_slots
+        self.spec = BoxSpec((0.0,) * slots, (1.0,) * slots, tuple(f"bid_{k}" for k in range(slots)))
+
+    def apply(self, view: AgentView, agents: IntArray, actions: np.ndarray) -> None:
+        """Keep each deciding agent's bids (clipped to [0, 1]) for its robot's next claim."""
+        rows = np.asarray(actions, dtype=float).reshape(len(agents), len(self.spec.low))
+        view.bids[agents] = np.clip(rows, 0.0, 1.0)

@@ -97,13 +97,16 @@ class AgentsAdapter:
         self.static = static
         self.cells = goal_cells(static, radius, fleet)
         self.series = run.settings(NavigationConfig).goals
-        self.movable = np.array([bool(len(c)) or bool(self.series) for c in self.cells], dtype=bool)
+        kind = ACTIONS.installed().get(cfg.action)
+        self.at_places = bool(getattr(kind, "goals_at_places", False))
+        self.goals = bool(getattr(kind, "goals", True))
+        """Whether agents have goals of this adapter's (not under the bid action)."""
+        movable = [self.goals and (bool(len(c)) or bool(self.series)) for c in self.cells]
+        self.movable = np.array(movable, dtype=bool)
         """Robots with somewhere to go (one walled in stays, and never arrives)."""
         # the goals adapter's streams and rule: with the same seed, cosim's own navigation
         # (robots.driver = "navigation") is sent to the same goals in the same order
         self.rngs = [run.rng.stream(f"goals/{name}") for name in names]
-        kind = ACTIONS.installed().get(cfg.action)
-        self.at_places = bool(getattr(kind, "goals_at_places", False))
         width, height = run.settings(WorldConfig).size_m
         lidar = run.settings(LidarConfig)
         beams = lidar.beams
@@ -129,6 +132,9 @@ class AgentsAdapter:
             heard_recv_ns=np.full((n, n), -1, dtype=np.int64),
             decided_ns=np.zeros(n, dtype=np.int64),
             woken_ns=np.full(n, -1, dtype=np.int64),
+            bids=np.zeros((n, cfg.task_slots)),
+            epochs=[None] * n,
+            epoch_ns=np.full(n, -1, dtype=np.int64),
         )
         self.set_ns = np.zeros(n, dtype=np.int64)
         self.goals_set = np.zeros(n, dtype=np.int64)
@@ -168,7 +174,9 @@ class AgentsAdapter:
     def _next_goal(self, i: int, now_ns: int) -> None:
         view, fleet = self.view, self.fleet
         k = int(self.goals_set[i])
-        if self.at_places and len(view.places):
+        if not self.goals:  # the bid action: an agent's tasks are its goals
+            x, y = fleet.x[i], fleet.y[i]
+        elif self.at_places and len(view.places):
             choices = len(view.places)
             pick = (i + k) % choices if self.series else int(self.rngs[i].integers(choices))
             x, y = view.places[pick]

@@ -61,6 +61,11 @@ class AgentView:
         heard_recv_ns: when it reached ``i`` (ns; -1: never heard).
         decided_ns: each agent's latest decision (ns).
         woken_ns: the latest event each agent is woken by (``agents.wake_on``; -1: none).
+        bids: each agent's latest bids (n, ``agents.task_slots``) in [0, 1] (the bid action).
+        epochs: each agent's latest epoch of open tasks (an
+            :class:`~adapters.assignment.contract.EpochView`; None before its first), from
+            the ``agent_bids`` assignment protocol.
+        epoch_ns: when each agent's latest epoch reached it (ns; -1: none yet).
     """
 
     run: RunContext
@@ -84,6 +89,9 @@ class AgentView:
     heard_recv_ns: IntArray
     decided_ns: IntArray
     woken_ns: IntArray
+    bids: FloatArray
+    epochs: list[Any]
+    epoch_ns: IntArray
 
     def __len__(self) -> int:
         return len(self.names)
@@ -171,6 +179,10 @@ class ActionKind(Protocol):
         adapters: the adapters it needs besides ``agents`` (``navigation`` to drive to a
             chosen place).
         spec: what one agent may do.
+
+    It may declare ``goals: ClassVar[bool] = False``: the agents have no goals of the
+    agents adapter's (the ``bid`` action: their tasks are their goals), and no arrivals are
+    counted.
     """
 
     name: ClassVar[str]

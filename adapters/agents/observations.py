@@ -170,3 +170,48 @@ class Places:
         rows = out.reshape(len(view), len(places), 2)
         rows[..., 0], rows[..., 1] = ahead, left
         np.clip(out, self.low, self.high, out=out)
+
+
+class Tasks:
+    """``tasks``: the open tasks the agent bids for (the bid action), slot by slot.
+
+    For each of the first ``agents.task_slots`` tasks of the latest epoch that reached the
+    agent's robot: where its station is (ahead, left; m, body frame), the robot's travel cost
+    to it (m, clipped to twice the room's perimeter) and whether it is free for this robot
+    (1: nobody else holds or claims it and the robot may serve it). An empty slot reads
+    ``0, 0, cost bound, 0``. 4 x ``agents.task_slots`` numbers.
+    """
+
+    name: ClassVar[str] = "tasks"
+
+    def __init__(self, view: AgentView) -> None:
+        slots, reach = view.settings.task_slots, _diagonal(view)
+        self.slots = slots
+        self.cost_bound = 4.0 * sum(view.room_m)
+        self.low, self.high = _bounds(
+            [-reach, -reach, 0.0, 0.0] * slots, [reach, reach, self.cost_bound, 1.0] * slots
+        )
+
+    def observe(self, view: AgentView, out: Float32Array) -> None:
+        """Every agent's task slots."""
+        fleet = view.fleet
+        rows = out.reshape(len(view), self.slots, 4)
+        rows[:] = 0.0
+        rows[..., 2] = self.cost_bound
+        for i, epoch in enumerate(view.epochs):
+            if epoch is None:
+                continue
+            tasks = epoch.tasks[: self.slots]
+            if not tasks:
+                continue
+            k = len(tasks)
+            dx = np.array([t.x_m for t in tasks]) - fleet.x[i]
+            dy = np.array([t.y_m for t in tasks]) - fleet.y[i]
+            ahead, left = to_body(dx, dy, np.full(k, fleet.yaw[i]))
+            cost = np.asarray(epoch.problem.cost[i, :k], dtype=float)
+            free = np.array([j not in epoch.taken for j in range(k)]) & np.isfinite(cost)
+            bound = self.cost_bound
+            rows[i, :k, 0], rows[i, :k, 1] = ahead, left
+            rows[i, :k, 2] = np.minimum(np.nan_to_num(cost, posinf=bound), bound)
+            rows[i, :k, 3] = free
+        np.clip(out, self.low, self.high, out=out)

@@ -57,15 +57,18 @@ class Sb3Policy:
 
     @classmethod
     def problems(cls, section: AgentsConfig) -> Iterator[Problem]:
-        """A model file is named and Stable-Baselines3 is installed."""
+        """A model file is named and exists (Stable-Baselines3 is looked for by the run)."""
         if not section.policy_file:
             yield Problem("policy_file", "", "a model saved by Stable-Baselines3 (model.save)")
         elif not Path(section.policy_file).is_file():
             yield Problem("policy_file", section.policy_file, "an existing file")
-        if importlib.util.find_spec("stable_baselines3") is None:
-            yield Problem("policy", "sb3", "stable-baselines3 installed (pip install 'cosim[rl]')")
 
     def __init__(self, view: AgentView, parts: AgentParts, observation_size: int) -> None:
+        if importlib.util.find_spec("stable_baselines3") is None:
+            raise ConfigError(
+                f"{view.run.scenario.source}: [agents] policy = 'sb3': expected "
+                "stable-baselines3 installed (pip install 'cosim[rl]'), not found"
+            )
         import stable_baselines3
         import torch
 

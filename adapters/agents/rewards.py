@@ -12,6 +12,7 @@ from typing import ClassVar
 import numpy as np
 
 from adapters.agents.contract import AgentView
+from adapters.tasks.source import TaskSourceAdapter
 from cosim.core.timebase import NS_PER_S
 from models.arrays import FloatArray
 
@@ -84,3 +85,24 @@ class Messages:
     def total(self, view: AgentView) -> FloatArray:
         """Broadcasts so far."""
         return view.sent.astype(float)
+
+
+class Tasks:
+    """``tasks``: tasks the agent's robot served to the end (the bid action's reward)."""
+
+    name: ClassVar[str] = "tasks"
+    weight: ClassVar[float] = 10.0
+
+    def __init__(self, view: AgentView) -> None:
+        self.index = {name: i for i, name in enumerate(view.names)}
+        self.count = len(view)
+
+    def total(self, view: AgentView) -> FloatArray:
+        """Tasks completed so far, by the robot that served them (0 without tasks)."""
+        totals = np.zeros(self.count)
+        if not view.run.has_service(TaskSourceAdapter):
+            return totals
+        for task in view.run.service(TaskSourceAdapter).book.tasks.values():
+            if task.completed_ns >= 0 and task.server in self.index:
+                totals[self.index[task.server]] += 1
+        return totals

@@ -1,8 +1,9 @@
 """``[agents]``: robots driven by learning agents (``robots.driver = "agents"``).
 
-A learning environment (:mod:`cosim.envs`) drives every robot through this section: at
-each decision an agent sees the observation parts ``observe`` names, acts through the
-action kind ``action`` names, and is rewarded by the weighted ``rewards``. Each agent has
+A learning environment (:mod:`cosim.envs`), or in a plain run the ``policy``, drives every
+robot through this section: at each decision an agent sees the observation parts
+``observe`` names, acts through the action kind ``action`` names (a velocity, a place to
+drive to, bids for open tasks), and is rewarded by the weighted ``rewards``. Each agent has
 a goal (a free place of the room drawn from its own random stream, or
 ``navigation.goals`` in turn) and tells the others its pose over the scenario's network
 at ``share_hz``, so what an agent hears of the others comes late or not at all as the
@@ -19,7 +20,7 @@ from cosim.core.registry import group_named
 from cosim.scenario.choices import choice_problems
 from cosim.scenario.fields import Problem, param
 
-Wake = Literal["arrival", "message", "contact"]
+Wake = Literal["arrival", "message", "contact", "task"]
 
 MIN_RATE_HZ = 1e-3
 """The slowest pose broadcast (Hz): one every 1,000 s."""
@@ -42,8 +43,9 @@ class AgentsConfig:
     )
     action: str = param(
         "velocity",
-        "what an agent does: 'velocity' (forward speed and yaw rate) or 'goal' (a place the "
-        "navigation drives to) (cosim.agent_actions)",
+        "what an agent does: 'velocity' (forward speed and yaw rate), 'goal' (a place the "
+        "navigation drives to) or 'bid' (bids for open tasks, with assignment.protocol = "
+        "'agent_bids') (cosim.agent_actions)",
         registry="cosim.agent_actions",
     )
     rewards: tuple[str, ...] = param(
@@ -64,7 +66,7 @@ class AgentsConfig:
         (),
         "events that make an agent decide before its next period, in the event-driven "
         "(AEC) environment: 'arrival' (its goal reached), 'message' (a pose heard), "
-        "'contact'",
+        "'contact', 'task' (a new set of open tasks reached it: the bid action)",
     )
     stagger: bool = param(
         False,
@@ -109,6 +111,13 @@ class AgentsConfig:
     policy_file: str = param("", "sb3 policy: the model file (saved by model.save)", path=True)
     sb3_algorithm: str = param(
         "PPO", "sb3 policy: the model's Stable-Baselines3 class (PPO, A2C, SAC, TD3, DQN)"
+    )
+    task_slots: int = param(
+        4,
+        "bid action: the open tasks an agent bids for (the first of each epoch it hears)",
+        ge=1,
+        le=64,
+        unit="count",
     )
     places: int = param(
         8,

@@ -92,3 +92,21 @@ def test_the_sb3_policy_needs_a_model_file():
 def test_an_environment_refuses_a_scenario_whose_policy_decides_itself():
     with pytest.raises(ConfigError, match=r"policy = 'random': expected 'none' in an environment"):
         WarehouseEnv("lab-room", overrides={"agents.policy": "random"})
+
+
+def test_the_sb3_policy_without_stable_baselines3_is_refused_when_the_run_is_built(monkeypatch):
+    import importlib.util
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(
+        importlib.util,
+        "find_spec",
+        lambda name, *a: None if name == "stable_baselines3" else real(name, *a),
+    )
+    model = "studies/policies/lab_goals_ppo.zip"
+    scenario = cosim.load_scenario(
+        "lab-room",
+        {"robots.driver": "agents", "agents.policy": "sb3", "agents.policy_file": model},
+    )  # a study naming the model loads anywhere
+    with pytest.raises(ConfigError, match=r"policy = 'sb3': expected stable-baselines3 installed"):
+        cosim.run(scenario, duration_s=1.0)

@@ -4,6 +4,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+from adapters.agents.bidding import AgentBids
 from adapters.assignment.contract import (
     PROTOCOLS,
     EpochView,
@@ -28,7 +29,8 @@ BUILT_IN = {
 
 
 def test_the_built_in_protocols_are_registered_and_keep_the_contract():
-    assert protocol_registry().load_all() == BUILT_IN
+    # and the learning agents' (adapters.agents.bidding), tested with them
+    assert protocol_registry().load_all() == {**BUILT_IN, "agent_bids": AgentBids}
     assert protocol_registry().group is PROTOCOLS
     for name, protocol in BUILT_IN.items():
         assert protocol.name == name

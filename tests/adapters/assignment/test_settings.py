@@ -59,8 +59,8 @@ def test_an_unknown_protocol_is_refused_with_the_nearest_and_the_registered_ones
         scenario(**{"assignment.protocol": "hungarain"})
     assert str(refused.value) == (
         "--set assignment.protocol: [assignment] protocol = 'hungarain': expected a registered "
-        "assignment protocol; did you mean 'hungarian'? (registered: cbba, distributed_simplex, "
-        "greedy, hungarian)"
+        "assignment protocol; did you mean 'hungarian'? (registered: agent_bids, cbba, "
+        "distributed_simplex, greedy, hungarian)"
     )
 
 

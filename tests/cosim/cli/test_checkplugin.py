@@ -43,6 +43,12 @@ def needs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, list[str]]:
         "cosim.mocap_sources:bag": [f"mocap.file='{track}'"],
         "cosim.topologies:explicit": ['network.edges=[["robot_1", "robot_2"]]'],
         "cosim.topologies:range": ["network.range_m=10.0"],
+        "cosim.agent_actions:bid": ["assignment.protocol='agent_bids'"],
+        "cosim.protocols:agent_bids": [
+            "robots.driver='agents'",
+            "agents.action='bid'",
+            "agents.policy='random'",
+        ],
         # the tutorial's model: one robot, its speed, goal and lidar sectors
         "cosim.agent_policies:sb3": [
             "robots.count=1",

@@ -169,7 +169,7 @@ def test_cosim_plugins_lists_a_clash_marked_among_the_entries_and_exits_2(clashi
     with on_path(clashing):
         done = cosim_main("plugins", "protocol")
     lines = done.stdout.splitlines()
-    assert lines[0] == "assignment protocols (cosim.protocols): 5"  # 4 names, 1 clash
+    assert lines[0] == "assignment protocols (cosim.protocols): 6"  # 5 names, 1 clash
     [marked] = [line for line in lines if "CLASH" in line]
     assert marked.split()[:2] == ["greedy", "CLASH:"]
     assert marked.endswith(CLASH.split("'greedy' is ", 1)[1])

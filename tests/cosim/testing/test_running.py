@@ -76,8 +76,8 @@ def test_a_protocol_given_in_code_runs_by_name_with_its_settings_and_is_gone_aft
     assert (result.scenario.seed, result.summary["sim_time_s"]) == (4, 5.0)
     assert result.tables["tasks"]["t_assigned_s"].notna().any()
     assert "first_free" not in PROTOCOLS.installed()
-    with pytest.raises(ConfigError, match=r"\(registered: cbba, distributed_simplex, greedy, "
-                       r"hungarian\)$"):  # fmt: skip
+    with pytest.raises(ConfigError, match=r"\(registered: agent_bids, cbba, distributed_simplex, "
+                       r"greedy, hungarian\)$"):  # fmt: skip
         cosim.load_scenario("warehouse-random", {"assignment.protocol": "first_free"})
 
 
