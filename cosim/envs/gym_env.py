@@ -16,7 +16,7 @@ import gymnasium
 import numpy as np
 
 from cosim.envs.agents import SEED_LIMIT, Agents
-from cosim.envs.rendering import frame
+from cosim.envs.rendering import checked_render_mode, frame
 from cosim.runner.result import RunResult
 from cosim.scenario.model import Scenario
 from models.arrays import Float32Array, UInt8Array
@@ -44,9 +44,7 @@ class WarehouseEnv(gymnasium.Env[Float32Array, np.ndarray]):
         duration_s: float | None = None,
         render_mode: str | None = None,
     ) -> None:
-        if render_mode not in (None, *self.metadata["render_modes"]):
-            raise ValueError(f"render_mode={render_mode!r}: expected None or 'rgb_array'")
-        self.render_mode = render_mode
+        self.render_mode = checked_render_mode(render_mode)
         self.agents = Agents(scenario, overrides, duration_s)
         self.metadata = {**self.metadata, "render_fps": self.agents.settings.decision_hz}
         n = len(self.agents)

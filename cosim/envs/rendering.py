@@ -22,6 +22,19 @@ from models.world.warehouse import Warehouse
 
 LONGER_IN = 6.0
 """The frame's longer side (inches, at 100 dpi: 600 pixels)."""
+RENDER_MODES = ("rgb_array",)
+"""What an environment can render (besides None: nothing)."""
+
+
+def checked_render_mode(render_mode: str | None) -> str | None:
+    """``render_mode`` if an environment can render it.
+
+    Raises:
+        ValueError: for any other (``"human"``: there is no window to draw in).
+    """
+    if render_mode is not None and render_mode not in RENDER_MODES:
+        raise ValueError(f"render_mode={render_mode!r}: expected None or 'rgb_array'")
+    return render_mode
 
 
 def frame(view: AgentView) -> UInt8Array:
