@@ -141,6 +141,7 @@ class AgentsAdapter:
         self.table = run.recorder.table(ARRIVALS)
         run.provide(self.view)
         run.bus.advertise(AGENT_STATES, RobotState)
+        self._share_topics = [AGENT_STATES] * n
         for i in range(n):
             self._next_goal(i, 0)
         observations, rewards = OBSERVATIONS.installed(), REWARDS.installed()
@@ -263,17 +264,13 @@ class AgentsAdapter:
     def _share(self, run: RunContext, now_ns: int) -> None:
         fleet = self.fleet
         radius = float(fleet.radius_m[0]) if len(fleet) else 0.0
-        for i, host in enumerate(self.hosts):
-            state = RobotState(
-                now_ns,
-                fleet.names[i],
-                float(fleet.x[i]),
-                float(fleet.y[i]),
-                float(fleet.yaw[i]),
-                float(fleet.v[i]),
-                radius,
-            )
-            run.bus.publish(AGENT_STATES, state, host)
+        x, y, yaw, v = fleet.x.tolist(), fleet.y.tolist(), fleet.yaw.tolist(), fleet.v.tolist()
+        states = [
+            RobotState(now_ns, name, x[i], y[i], yaw[i], v[i], radius)
+            for i, name in enumerate(fleet.names)
+        ]
+        # one publication for the fleet, as each robot's own in turn (the bus's batch)
+        run.bus.publish_many(self._share_topics, states, self.hosts)
         self.view.sent += 1
 
     def _arrivals(self, run: RunContext, now_ns: int) -> None:

@@ -8,6 +8,7 @@ hand-written drivers it is compared with.
 from __future__ import annotations
 
 import importlib
+import zipfile
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any, ClassVar
@@ -62,6 +63,12 @@ class Sb3Policy:
             yield Problem("policy_file", "", "a model saved by Stable-Baselines3 (model.save)")
         elif not Path(section.policy_file).is_file():
             yield Problem("policy_file", section.policy_file, "an existing file")
+        elif not zipfile.is_zipfile(section.policy_file):
+            yield Problem(
+                "policy_file",
+                section.policy_file,
+                "a model saved by Stable-Baselines3 (model.save writes a zip file)",
+            )
 
     def __init__(self, view: AgentView, parts: AgentParts, observation_size: int) -> None:
         if importlib.util.find_spec("stable_baselines3") is None:
@@ -81,7 +88,14 @@ class Sb3Policy:
                 f"{settings.sb3_algorithm!r}: expected a Stable-Baselines3 algorithm (PPO, A2C, "
                 "SAC, TD3, DQN)"
             )
-        self.model: Any = algorithm.load(settings.policy_file, device="cpu")
+        try:
+            self.model: Any = algorithm.load(settings.policy_file, device="cpu")
+        except Exception as error:  # a zip that is no model of this algorithm: the file's fault
+            raise ConfigError(
+                f"{view.run.scenario.source}: [agents] policy_file = {settings.policy_file!r}: "
+                f"expected a {settings.sb3_algorithm} model saved by Stable-Baselines3; loading "
+                f"it raised {type(error).__name__}: {error}"
+            ) from error
         shape = tuple(self.model.observation_space.shape)
         fleet, one = (len(view), observation_size), (observation_size,)
         if shape not in (fleet, one):
@@ -90,7 +104,6 @@ class Sb3Policy:
                 f"observes shape {shape}: expected {one} (one agent) or {fleet} (the fleet): "
                 "the same [agents] observe and robots.count it was trained with"
             )
-        self.joint = shape == fleet
 
     def act(self, observations: Float32Array) -> np.ndarray:
         """The model's deterministic actions for every agent."""

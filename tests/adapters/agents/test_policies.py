@@ -2,6 +2,8 @@ from typing import ClassVar
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import cosim
 from cosim.core.errors import ConfigError
@@ -110,3 +112,13 @@ def test_the_sb3_policy_without_stable_baselines3_is_refused_when_the_run_is_bui
     )  # a study naming the model loads anywhere
     with pytest.raises(ConfigError, match=r"policy = 'sb3': expected stable-baselines3 installed"):
         cosim.run(scenario, duration_s=1.0)
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.binary(max_size=256))
+def test_a_policy_file_that_is_no_saved_model_is_refused_naming_it(tmp_path_factory, content):
+    model = tmp_path_factory.mktemp("garbage") / "model.zip"
+    model.write_bytes(content)
+    overrides = {"agents.policy": "sb3", "agents.policy_file": str(model)}
+    with pytest.raises(ConfigError, match=r"policy_file = .*model\.zip.*Stable-Baselines3"):
+        cosim.load_scenario("lab-room", overrides)

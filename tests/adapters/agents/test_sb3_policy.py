@@ -61,3 +61,22 @@ def test_a_model_trained_on_other_observations_is_refused_naming_the_shapes(mode
     )
     with pytest.raises(ConfigError, match=r"observes shape \(1, 21\): expected \(5,\)"):
         cosim.run(scenario, duration_s=1.0)
+
+
+def test_a_zip_that_is_no_model_is_refused_naming_the_file_not_blamed_on_cosim(tmp_path):
+    import zipfile
+
+    fake = tmp_path / "notes.zip"
+    with zipfile.ZipFile(fake, "w") as archive:
+        archive.writestr("notes.txt", "not a policy")
+    scenario = cosim.load_scenario(
+        "lab-room",
+        {
+            **TASK,
+            "robots.driver": "agents",
+            "agents.policy": "sb3",
+            "agents.policy_file": str(fake),
+        },
+    )
+    with pytest.raises(ConfigError, match=r"notes\.zip.*expected a PPO model saved by"):
+        cosim.run(scenario, duration_s=1.0)
